@@ -1,0 +1,45 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+# `make demo` and `make test` each install missing Debian packages, build (Release, all cores), then run.
+
+BUILD_DIR ?= build
+JOBS      ?= $(shell nproc)
+DEMO_DIR  ?= out/demo
+
+# Libraries the build needs.
+BUILD_PACKAGES := cmake g++ make libopenvdb-dev libtbb-dev libeigen3-dev libdraco-dev libtinygltf-dev \
+                  libstb-dev libboost-iostreams-dev doctest-dev libmaxflow-dev liblinear-dev libcli11-dev nlohmann-json3-dev
+# Real checkers the tests run on the outputs: admesh (STL manifold check), draco_decoder.
+TEST_PACKAGES  := admesh draco
+
+.PHONY: all build test demo deps test-deps clean fuzz
+
+all: build
+
+deps:
+	@./tools/install-deps.sh $(BUILD_PACKAGES)
+
+test-deps:
+	@./tools/install-deps.sh $(BUILD_PACKAGES) $(TEST_PACKAGES)
+
+$(BUILD_DIR)/CMakeCache.txt:
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release
+
+build: deps $(BUILD_DIR)/CMakeCache.txt
+	cmake --build $(BUILD_DIR) -j $(JOBS)
+
+test: test-deps $(BUILD_DIR)/CMakeCache.txt
+	cmake --build $(BUILD_DIR) -j $(JOBS)
+	ctest --test-dir $(BUILD_DIR) --output-on-failure -j $(JOBS)
+
+demo: build
+	./tools/demo.sh $(BUILD_DIR) $(DEMO_DIR)
+
+# libFuzzer targets for the mesh readers (clang); run one with e.g. build-fuzz/fuzz/fuzz_stl -max_total_time=300
+fuzz:
+	@./tools/install-deps.sh $(BUILD_PACKAGES) clang libclang-rt-14-dev
+	CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DZOMEFAB_FUZZ=ON \
+	  -DZOMEFAB_BUILD_TESTS=OFF -DZOMEFAB_BUILD_TOOLS=OFF
+	cmake --build build-fuzz -j $(JOBS)
+
+clean:
+	rm -rf $(BUILD_DIR) build-fuzz out

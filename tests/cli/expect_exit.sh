@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# expect_exit.sh CODE REGEX [--no-file PATH]... -- COMMAND...
+# Runs COMMAND; fails unless it exits with CODE, its stderr matches the extended REGEX (on one line),
+# and none of the --no-file paths exists afterwards (no partial outputs on failure).
+set -u
+code=$1; regex=$2; shift 2
+nofiles=()
+while [ $# -gt 0 ] && [ "$1" != "--" ]; do
+  [ "$1" = "--no-file" ] && { nofiles+=("$2"); shift 2; continue; }
+  echo "expect_exit.sh: unknown argument $1" >&2; exit 2
+done
+shift
+for f in "${nofiles[@]+"${nofiles[@]}"}"; do rm -rf "$f"; done
+err=$(mktemp)
+"$@" > /dev/null 2> "$err"
+actual=$?
+status=0
+if [ "$actual" -ne "$code" ]; then echo "FAIL: exit code $actual, expected $code: $*" >&2; status=1; fi
+if ! grep -Eq -- "$regex" "$err"; then echo "FAIL: stderr does not match /$regex/" >&2; status=1; fi
+for f in "${nofiles[@]+"${nofiles[@]}"}"; do
+  if [ -e "$f" ]; then echo "FAIL: $f was written" >&2; status=1; fi
+done
+if ls -a "$(dirname "${nofiles[0]:-.}")" 2>/dev/null | grep -q '\.tmp[0-9]'; then
+  echo "FAIL: a temporary file was left behind" >&2; status=1
+fi
+echo "--- stderr:" >&2; cat "$err" >&2; rm -f "$err"
+exit $status

@@ -1,0 +1,40 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file Shared helpers for the unit tests: data paths, scratch directories, small fixtures.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "zomefab/core/tri_mesh.h"
+
+namespace zomefab::test {
+
+/// Absolute path of a file in the repository's data/ directory.
+std::string dataPath(const std::string& name);
+
+/// Absolute path of a built tool (build/tools/<name>).
+std::string toolPath(const std::string& name);
+
+/// A fresh empty directory under the system temp dir, removed when the object dies.
+class ScratchDir {
+public:
+    explicit ScratchDir(const std::string& tag = "zomefab-test");
+    ~ScratchDir();
+    ScratchDir(const ScratchDir&) = delete;
+    ScratchDir& operator=(const ScratchDir&) = delete;
+    const std::filesystem::path& path() const { return mPath; }
+    std::string file(const std::string& name) const { return (mPath / name).string(); }
+
+private:
+    std::filesystem::path mPath;
+};
+
+/// Writes @p bytes to @p path (test fixtures only).
+void writeBytes(const std::string& path, const std::string& bytes);
+
+/// An axis-aligned box [min, max] as 12 outward triangles on 8 shared vertices.
+TriMesh makeBox(const Vec3d& min, const Vec3d& max);
+/// A closed, outward UV sphere (rings × segments quads split into triangles, poles fanned).
+TriMesh makeSphere(const Vec3d& center, double radius, int rings = 32, int segments = 64);
+
+}  // namespace zomefab::test

@@ -1,0 +1,132 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "cli.h"
+
+#include <tbb/global_control.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <new>
+
+#include "zomefab/core/error.h"
+#include "zomefab/core/version.h"
+#include "zomefab/io/file_io.h"
+
+namespace zomefab::cli {
+
+namespace {
+
+std::atomic<bool> gInterrupted{false};
+
+extern "C" void onInterrupt(int) {
+    gInterrupted.store(true);
+    std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C kills at once
+}
+
+const char* levelPrefix(LogLevel level) {
+    switch (level) {
+    case LogLevel::Debug: return "debug: ";
+    case LogLevel::Info: return "";
+    case LogLevel::Warning: return "warning: ";
+    }
+    return "";
+}
+
+}  // namespace
+
+Tool::Tool(std::string name, std::string description)
+    : mName(std::move(name)), mApp(std::move(description), mName) {
+    mApp.set_version_flag("--version", std::string(generatorString()));
+    mApp.add_flag("-v,--verbose", mVerboseCount, "More messages on stderr (-vv for debug)");
+    mApp.add_flag("-q,--quiet", mQuiet, "Only errors on stderr");
+    mApp.add_option("--threads", mCommon.threads, "Worker threads (0 = all cores)")
+        ->check(CLI::NonNegativeNumber)
+        ->default_val(0);
+    mApp.add_option("--seed", mCommon.seed, "Random seed; same seed and input give the same output")
+        ->default_val(1);
+    mApp.add_option("--report", mCommon.reportPath, "Also write a JSON report to this file");
+    mApp.get_formatter()->column_width(34);
+}
+
+CLI::Option* Tool::addFormatOption(const std::string& flag, std::string& target,
+                                   const std::vector<std::string>& choices, const std::string& help) {
+    return mApp.add_option(flag, target, help)->check(CLI::IsMember(choices, CLI::ignore_case));
+}
+
+int Tool::run(int argc, char** argv, const std::function<int(nlohmann::json&)>& body) {
+    try {
+        mApp.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return mApp.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return mApp.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return mApp.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::cerr << mName << ": error: " << e.what() << " (see --help)\n";
+        return 1;
+    }
+    mCommon.verbosity = mQuiet ? -1 : mVerboseCount;
+    const int verbosity = mCommon.verbosity;
+    const std::string toolName = mName;
+    auto log = [toolName, verbosity](LogLevel level, const std::string& msg) {
+        if (level == LogLevel::Debug && verbosity < 2) return;
+        if (level == LogLevel::Info && verbosity < 0) return;
+        std::cerr << toolName << ": " << levelPrefix(level) << msg << '\n';
+    };
+    auto stageClock = std::make_shared<Stopwatch>();
+    auto lastPrint = std::make_shared<double>(-1.0);
+    auto lastStage = std::make_shared<std::string>();
+    auto progress = [toolName, verbosity, stageClock, lastPrint, lastStage](const std::string& stage,
+                                                                            double fraction) {
+        if (verbosity < 0) return;
+        const double now = stageClock->seconds();
+        const bool isNewStage = stage != *lastStage;
+        // At most two lines a second per stage, plus the start and end of each stage.
+        if (!isNewStage && fraction < 1.0 && now - *lastPrint < 0.5) return;
+        *lastStage = stage;
+        *lastPrint = now;
+        std::fprintf(stderr, "%s: [%s] %3d%% %.1f s\n", toolName.c_str(), stage.c_str(),
+                     int(fraction * 100.0 + 0.5), now);
+    };
+    mContext = std::make_unique<RunContext>(log, progress, &gInterrupted);
+    std::signal(SIGINT, onInterrupt);
+
+    std::unique_ptr<tbb::global_control> threadLimit;
+    if (mCommon.threads > 0)
+        threadLimit = std::make_unique<tbb::global_control>(
+            tbb::global_control::max_allowed_parallelism, size_t(mCommon.threads));
+
+    try {
+        nlohmann::json report;
+        const int code = body(report);
+        if (!mCommon.reportPath.empty()) {
+            report["tool"] = mName;
+            report["generator"] = generatorString();
+            report["warnings"] = mContext->warnings();
+            writeJsonFile(report, mCommon.reportPath);
+        }
+        return code;
+    } catch (const Error& e) {
+        std::cerr << mName << ": error: " << e.what() << '\n';
+        return exitCodeFor(e.code());
+    } catch (const std::bad_alloc&) {
+        std::cerr << mName << ": error: out of memory\n";
+        return 3;
+    } catch (const std::exception& e) {
+        std::cerr << mName << ": error: internal: " << e.what() << '\n';
+        return 3;
+    }
+}
+
+void printInfo(const Tool& tool, const std::string& message) {
+    if (tool.common().verbosity >= 0) std::cerr << tool.name() << ": " << message << '\n';
+}
+
+void writeJsonFile(const nlohmann::json& json, const std::string& path) {
+    writeOutputAtomic(path, [&](std::ostream& out) { out << json.dump(2) << '\n'; });
+}
+
+}  // namespace zomefab::cli
