@@ -39,7 +39,7 @@ fuzz:
 	@./tools/install-deps.sh $(BUILD_PACKAGES) clang libclang-rt-14-dev
 	CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DZOMEFAB_FUZZ=ON \
 	  -DZOMEFAB_BUILD_TESTS=OFF -DZOMEFAB_BUILD_TOOLS=OFF
-	cmake --build build-fuzz -j $(JOBS)
+	cmake --build build-fuzz -j $(JOBS) --target fuzz_all
 
 clean:
 	rm -rf $(BUILD_DIR) build-fuzz out

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-/// @file Stage 1: validate the input mesh (closedness, manifoldness, orientation, volume).
+/// @file Stage 1: check the input mesh (closedness, manifoldness, orientation, volume) and make it
+/// fit for the later stages, which need a closed, consistently outward-oriented surface.
 #pragma once
 
 #include <cstddef>
+#include <string>
 
 #include "zomefab/core/run_context.h"
 #include "zomefab/core/tri_mesh.h"
@@ -13,14 +15,17 @@ namespace zomefab::mesh {
 struct MeshReport {
     size_t vertexCount = 0;
     size_t triangleCount = 0;
-    Box3d bounds;
-    double volume = 0;               ///< signed, divergence theorem; > 0 for an outward closed mesh
+    size_t unreferencedVertices = 0;  ///< vertices no triangle uses
+    Box3d bounds;                     ///< of all finite vertices
+    double volume = 0;                ///< signed, divergence theorem; > 0 for an outward closed mesh
     double area = 0;
     size_t boundaryEdges = 0;        ///< edges used by exactly one triangle
+    size_t boundaryLoops = 0;        ///< connected chains of boundary edges (holes)
     Box3d boundaryBounds;            ///< where the boundary edges are (empty when none)
     size_t nonManifoldEdges = 0;     ///< edges used by three or more triangles
+    Box3d nonManifoldBounds;         ///< where they are (empty when none)
     size_t inconsistentEdges = 0;    ///< two-triangle edges traversed in the same direction by both
-    size_t degenerateTriangles = 0;  ///< repeated vertex index or zero area
+    size_t degenerateTriangles = 0;  ///< repeated vertex index, or twice the area <= 1e-9 x longest edge^2
     size_t duplicateTriangles = 0;   ///< same three vertices as an earlier triangle (any order)
     size_t nonFiniteVertices = 0;    ///< NaN or infinite coordinates
     size_t components = 0;           ///< edge-connected components of triangles
@@ -28,17 +33,32 @@ struct MeshReport {
     bool isConsistentlyOriented() const { return inconsistentEdges == 0; }
 };
 
+/// Measures @p mesh without changing it. Serial and deterministic; O(F log F).
+/// @pre every triangle index is < mesh.vertexCount() (readMesh guarantees it).
+/// @throw Error(InvalidInput) when a triangle refers to a vertex that does not exist.
 MeshReport checkMesh(const TriMesh& mesh);
 
 struct ValidateOptions {
-    bool repair = false;  ///< close small holes (boundary loops up to maxHoleEdges edges)
-    size_t maxHoleEdges = 200;
+    /// |volume| below this fraction of the bounding-box diagonal cubed counts as zero volume
+    /// (a flat or self-cancelling surface); 1e-9 keeps a 100 x 100 x 0.01 mm plate.
+    double minRelativeVolume = 1e-9;
+    /// Close holes: every boundary loop of at most maxHoleEdges edges is filled with the
+    /// minimum-area triangulation of its vertices (no new vertices), oriented to match its
+    /// neighbours. Loops that touch themselves or would need an edge the mesh already has are
+    /// left open (and then reported).
+    bool repair = false;
+    size_t maxHoleEdges = 300;  ///< larger holes are not filled
 };
 
-/// Makes @p mesh fit for the later stages or says exactly why it cannot be: non-finite
-/// coordinates, an open mesh (count and bounding box of the boundary edges), zero volume.
-/// Flips an inside-out closed mesh; drops degenerate and duplicate triangles with a warning.
-/// @throw Error(InvalidInput) naming @p sourceName.
+/// Makes @p mesh fit for the later stages or says exactly why it cannot be. In order:
+/// rejects an empty mesh and non-finite coordinates; drops triangles with a repeated vertex index
+/// and duplicate triangles (warning); drops unreferenced vertices; fills small holes when
+/// options.repair (warning; filled faces are not salient); rejects an open mesh (count,
+/// loops and bounding box of the boundary edges) and non-manifold edges; makes the orientation
+/// consistent within each component and outward (a component nested inside an odd number of
+/// others faces inward: a cavity), warning when it flips anything; rejects zero volume.
+/// salientFaces, when present, follow their triangles.
+/// @throw Error(InvalidInput) naming @p sourceName; Error(Cancelled) when @p context is cancelled.
 TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const std::string& sourceName,
                            RunContext& context);
 
