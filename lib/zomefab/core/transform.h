@@ -25,6 +25,10 @@ struct Transform4d {
     bool operator==(const Transform4d& o) const { return m == o.m; }
 };
 
+/// The inverse of the affine transform @p t (last row 0 0 0 1); the identity's inverse is exact.
+/// @throw Error(InvalidInput) when the 3×3 part is singular.
+Transform4d affineInverse(const Transform4d& t);
+
 /// Applies @p t to every vertex of @p mesh in place.
 void transformInPlace(TriMesh& mesh, const Transform4d& t);
 

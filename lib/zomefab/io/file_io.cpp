@@ -67,6 +67,55 @@ void writeOutputAtomic(const std::string& path, const std::function<void(std::os
     }
 }
 
+StagedDirectory::StagedDirectory(const std::string& target, const std::string& markerFile)
+    : mTarget(target), mMarker(markerFile) {
+    fs::path t(target);
+    while (!t.empty() && t.filename().empty()) t = t.parent_path();  // "out/" -> "out"
+    if (t.empty()) throw Error(ErrorCode::WriteFailed, "empty output directory name", target);
+    mTarget = t.string();
+    const fs::path parent = t.has_parent_path() ? t.parent_path() : fs::path(".");
+    std::error_code ec;
+    if (!fs::is_directory(parent, ec))
+        throw Error(ErrorCode::WriteFailed, "parent directory does not exist: " + parent.string(), target);
+    if (fs::exists(t, ec) && !fs::is_directory(t, ec))
+        throw Error(ErrorCode::WriteFailed, "exists and is not a directory", target);
+    mStaging = (parent / ("." + t.filename().string() + ".tmp" + std::to_string(::getpid()))).string();
+    fs::remove_all(mStaging, ec);
+    if (!fs::create_directory(mStaging, ec))
+        throw Error(ErrorCode::WriteFailed, "cannot create a staging directory: " + ec.message(), target);
+}
+
+StagedDirectory::~StagedDirectory() {
+    if (mCommitted) return;
+    std::error_code ec;
+    fs::remove_all(mStaging, ec);
+}
+
+void StagedDirectory::commit() {
+    std::error_code ec;
+    const fs::path target(mTarget);
+    if (fs::exists(target, ec)) {
+        const bool isEmpty = fs::is_empty(target, ec);
+        if (!isEmpty && !fs::exists(target / mMarker, ec))
+            throw Error(ErrorCode::WriteFailed,
+                        "exists and is not an output of this tool (no " + mMarker + "); not replacing it",
+                        mTarget);
+        const fs::path old = target.string() + ".old" + std::to_string(::getpid());
+        fs::rename(target, old, ec);
+        if (ec) throw Error(ErrorCode::WriteFailed, "cannot move the old output aside: " + ec.message(), mTarget);
+        fs::rename(mStaging, target, ec);
+        if (ec) {
+            fs::rename(old, target);  // put the old output back
+            throw Error(ErrorCode::WriteFailed, "cannot move the output into place: " + ec.message(), mTarget);
+        }
+        fs::remove_all(old, ec);
+    } else {
+        fs::rename(mStaging, target, ec);
+        if (ec) throw Error(ErrorCode::WriteFailed, "cannot move the output into place: " + ec.message(), mTarget);
+    }
+    mCommitted = true;
+}
+
 std::string fileExtension(const std::string& path) {
     std::string ext = fs::path(path).extension().string();
     if (!ext.empty() && ext[0] == '.') ext.erase(0, 1);

@@ -17,6 +17,32 @@ std::string readInputBytes(const std::string& path);
 /// @throw Error(WriteFailed) naming the file; whatever @p write throws is rethrown after cleanup.
 void writeOutputAtomic(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+/// An output directory built in a temporary sibling and moved into place by commit(), so a run that
+/// fails (or is interrupted) leaves no half-written directory. Without commit() the staging
+/// directory is removed. commit() replaces an existing target only when it is empty or holds
+/// @p markerFile (a previous output of the same tool); anything else is refused, never deleted.
+class StagedDirectory {
+public:
+    /// @throw Error(WriteFailed) when the parent directory does not exist or is not writable.
+    StagedDirectory(const std::string& target, const std::string& markerFile);
+    ~StagedDirectory();
+    StagedDirectory(const StagedDirectory&) = delete;
+    StagedDirectory& operator=(const StagedDirectory&) = delete;
+
+    /// Where to write now (the staging directory).
+    const std::string& path() const { return mStaging; }
+    /// path()/@p name
+    std::string file(const std::string& name) const { return mStaging + "/" + name; }
+    /// Moves the staging directory to the target. @throw Error(WriteFailed)
+    void commit();
+
+private:
+    std::string mTarget;
+    std::string mMarker;
+    std::string mStaging;
+    bool mCommitted = false;
+};
+
 /// Lower-case extension of @p path without the dot ("mesh.STL" -> "stl"), empty when none.
 std::string fileExtension(const std::string& path);
 

@@ -1,0 +1,253 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "zomefab/frame/lattice.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "zomefab/core/error.h"
+#include "zomefab/frame/frame_field.h"
+
+namespace zomefab::frame {
+
+namespace {
+
+/// One placement of the lattice: which lattice points are balls, which edges are struts, which
+/// cells are whole cubes.
+struct Placement {
+    double rotationDeg = 0;
+    Vec3d offsetMm{0, 0, 0};  ///< frame mm of index (0,0,0)
+    int lo[3] = {0, 0, 0};    ///< index range [lo, lo + n)
+    int n[3] = {0, 0, 0};
+    std::vector<uint8_t> isCube;  ///< per cell (i,j,k) in [lo, lo+n−1)
+    size_t cubes = 0;
+
+    size_t index(int i, int j, int k) const {
+        return (size_t(i - lo[0]) * size_t(n[1]) + size_t(j - lo[1])) * size_t(n[2]) + size_t(k - lo[2]);
+    }
+};
+
+/// Frame-space box of the field's box rotated by −rotation about z.
+Box3d frameBox(const FrameField& ff) {
+    const Box3d b = ff.field().boundsMm();
+    Box3d out;
+    for (int c = 0; c < 8; ++c) {
+        const Vec3d p{(c & 1) ? b.max[0] : b.min[0], (c & 2) ? b.max[1] : b.min[1],
+                      (c & 4) ? b.max[2] : b.min[2]};
+        out.expand(ff.toFrameMm(p));
+    }
+    return out;
+}
+
+/// Evaluates one placement: ball and edge validity, whole cubes.
+Placement evaluate(const FrameField& ff, double rotationDeg, const Vec3d& offsetMm) {
+    Placement pl;
+    pl.rotationDeg = rotationDeg;
+    pl.offsetMm = offsetMm;
+    const double b0 = ff.scale().b0Mm;
+    const Box3d box = frameBox(ff);
+    for (int a = 0; a < 3; ++a) {
+        pl.lo[a] = int(std::floor((box.min[a] - offsetMm[a]) / b0));
+        pl.n[a] = int(std::ceil((box.max[a] - offsetMm[a]) / b0)) - pl.lo[a] + 1;
+    }
+    const size_t count = size_t(pl.n[0]) * size_t(pl.n[1]) * size_t(pl.n[2]);
+    std::vector<double> depth(count);
+    std::vector<uint8_t> ballOk(count);
+    auto pos = [&](int i, int j, int k) {
+        return Vec3d{offsetMm[0] + b0 * i, offsetMm[1] + b0 * j, offsetMm[2] + b0 * k};
+    };
+    for (int i = pl.lo[0]; i < pl.lo[0] + pl.n[0]; ++i)
+        for (int j = pl.lo[1]; j < pl.lo[1] + pl.n[1]; ++j)
+            for (int k = pl.lo[2]; k < pl.lo[2] + pl.n[2]; ++k) {
+                const size_t id = pl.index(i, j, k);
+                depth[id] = ff.depthMm(pos(i, j, k));
+                ballOk[id] = ff.isBallAllowed(depth[id]) ? 1 : 0;
+            }
+    // edgeOk[3·id + axis]: the B0 strut from (i,j,k) along +axis is clear.
+    const double limit = ff.strutDepthLimitMm(zome::Color::Blue);
+    std::vector<uint8_t> edgeOk(3 * count, 0);
+    for (int i = pl.lo[0]; i < pl.lo[0] + pl.n[0]; ++i)
+        for (int j = pl.lo[1]; j < pl.lo[1] + pl.n[1]; ++j)
+            for (int k = pl.lo[2]; k < pl.lo[2] + pl.n[2]; ++k) {
+                const size_t id = pl.index(i, j, k);
+                if (!ballOk[id]) continue;
+                const int ijk[3] = {i, j, k};
+                for (int a = 0; a < 3; ++a) {
+                    int e[3] = {i, j, k};
+                    e[a] += 1;
+                    if (e[a] >= pl.lo[a] + pl.n[a]) continue;
+                    const size_t other = pl.index(e[0], e[1], e[2]);
+                    if (!ballOk[other]) continue;
+                    edgeOk[3 * id + size_t(a)] =
+                        ff.isSegmentAllowed(pos(ijk[0], ijk[1], ijk[2]), depth[id],
+                                            pos(e[0], e[1], e[2]), depth[other], limit)
+                            ? 1
+                            : 0;
+                }
+            }
+    pl.isCube.assign(count, 0);
+    for (int i = pl.lo[0]; i + 1 < pl.lo[0] + pl.n[0]; ++i)
+        for (int j = pl.lo[1]; j + 1 < pl.lo[1] + pl.n[1]; ++j)
+            for (int k = pl.lo[2]; k + 1 < pl.lo[2] + pl.n[2]; ++k) {
+                // 12 edges: the 4 along each axis, starting at the cell's corners with that
+                // axis coordinate at its low end.
+                bool ok = true;
+                for (int a = 0; a < 3 && ok; ++a) {
+                    for (int c = 0; c < 4 && ok; ++c) {
+                        int e[3] = {i, j, k};
+                        e[(a + 1) % 3] += c & 1;
+                        e[(a + 2) % 3] += (c >> 1) & 1;
+                        ok = edgeOk[3 * pl.index(e[0], e[1], e[2]) + size_t(a)] != 0;
+                    }
+                }
+                if (ok) {
+                    pl.isCube[pl.index(i, j, k)] = 1;
+                    ++pl.cubes;
+                }
+            }
+    return pl;
+}
+
+std::string mm1(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.1f", v);
+    return buf;
+}
+
+}  // namespace
+
+LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptions& options,
+                             RunContext& context) {
+    if (options.offsetSteps < 1)
+        throw Error(ErrorCode::Usage, "lattice offset steps must be at least 1");
+    if (options.searchRotation && !(options.rotationStepDeg > 0))
+        throw Error(ErrorCode::Usage, "lattice rotation step must be positive");
+    if (field.empty())
+        throw Error(ErrorCode::ProcessingFailed, "the interior field is empty");
+    options.scale.validate();
+    context.progress("lattice", 0.0);
+
+    std::vector<double> rotations{0.0};
+    if (options.searchRotation)
+        for (double r = options.rotationStepDeg; r < 90.0 - 1e-9; r += options.rotationStepDeg)
+            rotations.push_back(r);
+    const int steps = options.offsetSteps;
+    const size_t perRotation = size_t(steps) * size_t(steps) * size_t(steps);
+    const size_t total = rotations.size() * perRotation;
+    const double b0 = options.scale.b0Mm;
+
+    // Offsets are relative to the min corner of the frame-space box of each rotation.
+    std::vector<size_t> cubes(total, 0);
+    std::vector<FrameField> fields;
+    std::vector<Vec3d> corners;
+    for (double r : rotations) {
+        fields.emplace_back(field, r, options.scale, options.zone);
+        corners.push_back(frameBox(fields.back()).min);
+    }
+    auto offsetOf = [&](size_t p) {
+        const size_t r = p / perRotation, q = p % perRotation;
+        const int oi = int(q / size_t(steps * steps)), oj = int((q / size_t(steps)) % size_t(steps)),
+                  ok = int(q % size_t(steps));
+        const Vec3d& c = corners[r];
+        return Vec3d{c[0] + b0 * oi / steps, c[1] + b0 * oj / steps, c[2] + b0 * ok / steps};
+    };
+    tbb::parallel_for(size_t(0), total, [&](size_t p) {
+        if (context.isCancelled()) return;
+        cubes[p] = evaluate(fields[p / perRotation], rotations[p / perRotation], offsetOf(p)).cubes;
+    });
+    context.throwIfCancelled();
+    // The first maximum in placement order: deterministic whatever the thread count.
+    const size_t best = size_t(std::max_element(cubes.begin(), cubes.end()) - cubes.begin());
+    if (cubes[best] == 0) {
+        const double deepest = deepestDepthMm(field);
+        const double need = options.zone.dMinMm + options.scale.ballRadiusMm();
+        throw Error(ErrorCode::ProcessingFailed,
+                    "object too thin for one B0 cube: the thickest inner region found is about " +
+                        mm1(2.0 * std::max(0.0, deepest)) + " mm across (deepest point " +
+                        mm1(deepest) + " mm inside the surface); a cube needs its 8 balls at least " +
+                        mm1(need) + " mm inside (dMin + ball radius), a region about " +
+                        mm1(b0 + 2.0 * need) + " mm across (b0 + 2 x " + mm1(need) + " mm)");
+    }
+
+    const FrameField& ff = fields[best / perRotation];
+    const Placement pl = evaluate(ff, rotations[best / perRotation], offsetOf(best));
+
+    // Balls and struts of the whole cubes; union-find over lattice points for the components.
+    const size_t count = pl.isCube.size();
+    std::vector<uint8_t> isBall(count, 0);
+    std::vector<uint8_t> edge(3 * count, 0);
+    for (int i = pl.lo[0]; i + 1 < pl.lo[0] + pl.n[0]; ++i)
+        for (int j = pl.lo[1]; j + 1 < pl.lo[1] + pl.n[1]; ++j)
+            for (int k = pl.lo[2]; k + 1 < pl.lo[2] + pl.n[2]; ++k) {
+                if (!pl.isCube[pl.index(i, j, k)]) continue;
+                for (int c = 0; c < 8; ++c)
+                    isBall[pl.index(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))] = 1;
+                for (int a = 0; a < 3; ++a)
+                    for (int c = 0; c < 4; ++c) {
+                        int e[3] = {i, j, k};
+                        e[(a + 1) % 3] += c & 1;
+                        e[(a + 2) % 3] += (c >> 1) & 1;
+                        edge[3 * pl.index(e[0], e[1], e[2]) + size_t(a)] = 1;
+                    }
+            }
+    std::vector<size_t> parent(count);
+    std::iota(parent.begin(), parent.end(), size_t(0));
+    auto find = [&](size_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+    };
+    auto step = [&](size_t id, int a) {
+        const size_t s = size_t(pl.n[2]);
+        return a == 0 ? id + size_t(pl.n[1]) * s : a == 1 ? id + s : id + 1;
+    };
+    for (size_t id = 0; id < count; ++id)
+        for (int a = 0; a < 3; ++a)
+            if (edge[3 * id + size_t(a)]) {
+                const size_t x = find(id), y = find(step(id, a));
+                if (x != y) parent[std::max(x, y)] = std::min(x, y);
+            }
+    std::vector<size_t> size(count, 0);
+    for (size_t id = 0; id < count; ++id)
+        if (isBall[id]) ++size[find(id)];
+    size_t keep = 0;
+    for (size_t id = 0; id < count; ++id)
+        if (size[id] > size[keep]) keep = id;  // first largest: deterministic
+
+    zome::ZomeScale scale = options.scale;
+    scale.originMm = pl.offsetMm;
+    LatticeResult result{zome::Structure(scale, options.collision)};
+    result.rotationDeg = pl.rotationDeg;
+    result.offsetMm = pl.offsetMm;
+    result.cubes = pl.cubes;
+    result.placementsTried = total;
+    result.firstPlacementCubes = cubes[0];
+    zome::Structure& s = result.structure;
+    const zome::Golden b0Units(2, 2);  // B0 = 2φ² = 2 + 2φ vZome units
+    std::vector<zome::BallId> ballId(count, zome::kNoId);
+    for (int i = pl.lo[0]; i < pl.lo[0] + pl.n[0]; ++i)
+        for (int j = pl.lo[1]; j < pl.lo[1] + pl.n[1]; ++j)
+            for (int k = pl.lo[2]; k < pl.lo[2] + pl.n[2]; ++k) {
+                const size_t id = pl.index(i, j, k);
+                if (isBall[id] && find(id) == keep)
+                    ballId[id] = s.addBall({b0Units * zome::Golden(i), b0Units * zome::Golden(j),
+                                            b0Units * zome::Golden(k)});
+            }
+    for (size_t id = 0; id < count; ++id)
+        for (int a = 0; a < 3; ++a)
+            if (edge[3 * id + size_t(a)] && ballId[id] != zome::kNoId)
+                s.addStrut(ballId[id], ballId[step(id, a)]);
+    for (int i = pl.lo[0]; i + 1 < pl.lo[0] + pl.n[0]; ++i)
+        for (int j = pl.lo[1]; j + 1 < pl.lo[1] + pl.n[1]; ++j)
+            for (int k = pl.lo[2]; k + 1 < pl.lo[2] + pl.n[2]; ++k)
+                if (pl.isCube[pl.index(i, j, k)] && find(pl.index(i, j, k)) == keep)
+                    ++result.keptCubes;
+    context.progress("lattice", 1.0);
+    return result;
+}
+
+}  // namespace zomefab::frame

@@ -1,0 +1,160 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file Surface partition (paper §5): label the shell's outer triangles with the frame's outermost
+/// balls by a multi-label graph cut (Eq. 1–4), lower w_smoothness until every partition fits the
+/// printer, replace the zig-zag seams by planar cuts from a multi-class linear SVM, and turn the
+/// cells into connected pieces that fit the printer. docs/partition.md explains each step.
+///
+/// @code
+///   TriMesh meshMm = readMesh(path);  transformInPlace(meshMm, transformMm);
+///   const auto labels = frame::outermostBalls(structure);          // N_out
+///   PartitionResult r = partitionSurface(meshMm, structure, labels, {}, ctx);
+///   nlohmann::json j = partitionToJson(r, meshMm);
+/// @endcode
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "zomefab/core/run_context.h"
+#include "zomefab/core/tri_mesh.h"
+#include "zomefab/partition/linear_cells.h"
+#include "zomefab/partition/printer_fit.h"
+#include "zomefab/zome/structure.h"
+
+namespace zomefab::partition {
+
+/// A sphere of faces the user wants kept whole (`--salient x,y,z,r`), in the mesh's mm frame.
+struct SalientSphere {
+    Vec3d centerMm{0, 0, 0};
+    double radiusMm = 0.0;
+};
+
+struct PartitionOptions {
+    // --- energy, Eq. (1)–(4) -----------------------------------------------------------------
+    double dataWeight = 1.0;       ///< w_data (paper: 1.0 for all shapes)
+    double saliencyWeight = 5.0;   ///< w_saliency (paper: 5.0)
+    /// k: the candidate labels of a triangle are its k nearest label balls; every other label
+    /// gets a prohibitive (infinite) data cost, so a piece always lies over balls near it.
+    int candidateCount = 8;
+    /// d(t, n) is measured in units of b0 and clamped below at this value, so D = log d is finite
+    /// (a centroid cannot reach a ball centre anyway: the shell and the ball radius lie between).
+    double minDistanceB0 = 0.05;
+    /// θ is clamped below at this angle (radians) so −log(θ/π) is finite on flat parts (Eq. 3).
+    double minDihedralRad = 1e-3;
+
+    // --- fit schedule (§5.1) ------------------------------------------------------------------
+    double smoothnessStart = 10.0;   ///< first w_smoothness (paper: 10)
+    double smoothnessFactor = 0.1;   ///< w_smoothness *= this while a partition does not fit
+    /// The schedule bottoms out when the next w_smoothness would fall below this; oversized
+    /// partitions are then split (and the result says so).
+    double smoothnessMin = 1e-3;
+    Vec3d printerMm{200.0, 200.0, 200.0};  ///< build volume (paper: Ultimaker 3, 215×215×200 → 200³)
+    /// Every side of a piece's oriented box is grown by this much before the fit test, for the
+    /// shell's thickness behind the surface and the connectors (mm).
+    double fitMarginMm = 2.0;
+    int maxSweeps = 100;  ///< alpha-expansion passes per graph cut at most
+
+    // --- saliency (§5.1, Eq. 4): union of the mesh's salientFaces flags and these ---------------
+    std::vector<SalientSphere> salientSpheres;  ///< faces touching a sphere are salient
+    std::vector<uint32_t> salientFaceIndices;   ///< faces marked by index
+
+    // --- planar cuts (§5.2) -------------------------------------------------------------------
+    CellTrainingOptions svm;  ///< seed is taken from @c seed below
+    /// Training samples at most: above it, all faces near a seam are kept and the others thinned
+    /// evenly (deterministic), which keeps training time flat on large meshes.
+    size_t svmMaxSamples = 20000;
+    /// Retraining rounds when a cut crosses a salient region (its samples weighted up each round).
+    int salientRetries = 3;
+
+    // --- pieces -------------------------------------------------------------------------------
+    /// A piece smaller than this (mm², outer surface) is merged into the neighbour it shares the
+    /// longest seam with, when the merged piece still fits: too small to carry a connector.
+    double minPieceAreaMm2 = 400.0;
+    int maxRepairRounds = 8;  ///< split-and-retrain rounds for pieces that do not fit
+
+    // --- graph size -------------------------------------------------------------------------
+    /// Above this many faces the graph cut runs on about this many clusters of edge-connected
+    /// faces (breadth-first from the lowest unassigned face, never across a salient boundary), so
+    /// its cost does not grow with the tessellation; 0 = every face is a node. The seams the SVM
+    /// learns from then follow cluster boundaries (a few mm on a 400 mm bunny).
+    size_t graphNodeTarget = 20000;
+
+    uint64_t seed = 1;  ///< for liblinear's shuffling
+};
+
+/// One step of the fit schedule.
+struct ScheduleStep {
+    double smoothnessWeight = 0.0;
+    double energyNearest = 0.0;   ///< E of the starting (nearest-ball) labelling at this weight
+    double energyGraphCut = 0.0;  ///< E after alpha-expansion
+    size_t partitions = 0;        ///< connected label regions
+    size_t oversized = 0;         ///< regions that do not fit the printer
+    int sweeps = 0;
+    int expansions = 0;
+    double seconds = 0.0;
+};
+
+/// A physical piece: connected surface faces, one or more cells, fitting the printer.
+struct Piece {
+    std::vector<uint32_t> cells;      ///< the cells it is made of (several after a merge)
+    std::vector<zome::BallId> balls;  ///< the label balls of those cells
+    uint32_t faceCount = 0;
+    double areaMm2 = 0.0;
+    Box3d boundsMm;                   ///< axis-aligned box of its faces' vertices
+    PrinterFit fit;                   ///< best orientation in the printer
+};
+
+struct PartitionResult {
+    double b0Mm = 47.3;
+    Vec3d printerMm{200, 200, 200};
+    double fitMarginMm = 0.0;
+    std::vector<zome::BallId> labelBalls;   ///< label index → ball id (the input N_out order)
+    std::vector<uint32_t> nearestLabels;    ///< per face: label of the nearest ball
+    std::vector<uint32_t> graphCutLabels;   ///< per face: label after the accepted graph cut
+    LinearCells cells;                      ///< argmax cells in mm
+    std::vector<zome::BallId> cellBalls;    ///< cell → the ball it attaches to
+    std::vector<uint32_t> faceCells;        ///< per face: the cell containing its centroid
+    std::vector<uint32_t> facePieces;       ///< per face: its piece
+    std::vector<Piece> pieces;
+    std::vector<uint8_t> salientFaces;      ///< per face (after spheres and indices)
+    size_t salientRegions = 0;              ///< edge-connected salient regions
+    size_t salientRegionsSplit = 0;         ///< regions a final seam still crosses (0 normally)
+
+    std::vector<ScheduleStep> schedule;
+    double smoothnessWeight = 0.0;          ///< the accepted w_smoothness
+    double energyNearest = 0.0;             ///< E(nearest-ball labelling) at that weight
+    double energyGraphCut = 0.0;            ///< E(graph cut) at that weight
+    std::vector<double> sweepEnergies;      ///< of the accepted graph cut
+    size_t nearestPartitions = 0;           ///< connected regions of the nearest-ball labelling
+    size_t graphCutPartitions = 0;          ///< connected regions of the graph cut
+    bool isScheduleBottomedOut = false;     ///< the schedule ended without every partition fitting
+    size_t splits = 0;                      ///< partitions/pieces split to fit the printer
+    size_t merges = 0;                      ///< small pieces merged into a neighbour
+    size_t svmSamples = 0;                  ///< training samples used
+    double svmAgreement = 0.0;              ///< fraction of faces whose cell matches its region
+    size_t graphNodes = 0;                  ///< graph-cut nodes (faces, clusters, salient regions)
+    size_t candidatePairs = 0;              ///< Σ candidates over nodes: the "triangles × labels"
+    double secondsGraphCut = 0.0;
+    double secondsSvm = 0.0;
+    double secondsTotal = 0.0;
+};
+
+/// Partitions the outer surface @p meshMm (mm, in the frame's coordinates) with the balls
+/// @p labelBalls of @p frame as labels.
+/// @throw Error(InvalidInput) for an empty mesh, no label balls, a label that is not a ball of
+///   the frame, or a frame that does not sit inside the mesh (mesh/frame mismatch);
+///   Error(Usage) for bad options (printer smaller than a ball, k < 1, bad weights, a salient face
+///   index out of range); Error(Cancelled).
+PartitionResult partitionSurface(const TriMesh& meshMm, const zome::Structure& frame,
+                                 const std::vector<zome::BallId>& labelBalls, const PartitionOptions& options,
+                                 const RunContext& context);
+
+/// Checks @p options on their own (before any input is read). @throw Error(Usage)
+void checkPartitionOptions(const PartitionOptions& options, const zome::ZomeScale& scale = {});
+
+/// Per-face flags: the mesh's salientFaces, faces within a sphere (closest point of the triangle
+/// within the radius) and the listed indices. @throw Error(Usage) for an index out of range.
+std::vector<uint8_t> salientFaceFlags(const TriMesh& meshMm, const std::vector<SalientSphere>& spheres,
+                                      const std::vector<uint32_t>& indices);
+
+}  // namespace zomefab::partition

@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file In-memory conversions of a PartitionResult: the versioned `zomefab.partition` JSON that
+/// the pieces stage reads (docs/partition.md, "PARTITION.json"), and a PLY with one colour per face
+/// to look at labellings. No file access: tools write the bytes atomically.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "zomefab/core/transform.h"
+#include "zomefab/partition/partition.h"
+
+namespace zomefab::partition {
+
+inline constexpr const char* kPartitionFormatName = "zomefab.partition";
+inline constexpr int kPartitionFormatVersion = 1;
+
+/// What the JSON records about the run besides the result.
+struct PartitionJsonInfo {
+    std::string meshFile;
+    std::string frameFile;
+    Transform4d transformMm;  ///< the frame's transform_mm (mesh file coordinates → mm)
+    size_t vertexCount = 0;
+};
+
+/// The PARTITION.json document. Contains no timings, so equal inputs give equal bytes.
+nlohmann::json partitionToJson(const PartitionResult& result, const PartitionOptions& options,
+                               const PartitionJsonInfo& info);
+
+/// Binary little-endian PLY of @p meshMm with `uchar red, green, blue` and `int group` per face:
+/// @p faceGroups (piece, cell or label ids) coloured by a golden-ratio hue walk, so neighbouring
+/// ids get distinct colours. @throw Error(Usage) when the sizes differ.
+std::string coloredPlyBytes(const TriMesh& meshMm, const std::vector<uint32_t>& faceGroups);
+
+}  // namespace zomefab::partition

@@ -1,0 +1,124 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file Printable pieces (paper §6): the shell cut by the partition's cells with level-set CSG,
+/// split into connected pieces, tenons grown from the inner surface into free blue holes of the
+/// frame's balls (§6.1), an engraved piece number, meshing, and an orientation that fits the
+/// printer. No OpenVDB in this header. docs/pieces.md explains each step.
+///
+/// @code
+///   const Transform4d frameToGrid = shell.info().transformMm * affineInverse(frameTransformMm);
+///   Pieces p = makePieces(shell, frame, frameToGrid, cells, requests, options, context);
+///   writePieces(p, "out/pieces", {"shell.vdb", "frame.json", "partition.json"});
+/// @endcode
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "zomefab/core/run_context.h"
+#include "zomefab/core/transform.h"
+#include "zomefab/core/tri_mesh.h"
+#include "zomefab/pieces/label.h"
+#include "zomefab/pieces/tenons.h"
+#include "zomefab/sdf/level_set.h"
+#include "zomefab/zome/structure.h"
+
+namespace zomefab::pieces {
+
+/// The partition's cells (paper §5.2) in the frame's millimetres: cell k = {x : w_k·x + b_k is
+/// largest}, ties to the lowest k. Argmax cells are convex and cover space without gaps or
+/// overlaps; the face between cells k and j lies on the plane (w_k − w_j)·x + (b_k − b_j) = 0.
+struct CellModel {
+    std::vector<Vec3d> w;   ///< per cell, 1/mm
+    std::vector<double> b;  ///< per cell, dimensionless
+    size_t cellCount() const { return w.size(); }
+};
+
+/// One piece the partition asks for: the cells it is cut from (several after the partition merged
+/// small pieces) and the box of its outer surface, which tells apart the pieces that share a cell
+/// (a cell whose surface falls apart into separate patches).
+struct PieceRequest {
+    std::vector<uint32_t> cells;
+    Box3d boundsMm;  ///< frame mm; empty = unknown
+};
+
+struct PiecesOptions {
+    /// Connected pieces with less volume are merged into the neighbour they share the largest cut
+    /// face with (a 2 cm³ sliver is too small to carry a tenon or to print well). Never dropped:
+    /// an isolated sliver stays a piece of its own, with a warning.
+    double minPieceVolumeMm3 = 2000.0;
+    TenonOptions tenons;
+    LabelOptions label;
+    /// Build volume of the printer (paper: Ultimaker 3, 200 mm cube), any order of the sides.
+    Vec3d printerMm{200.0, 200.0, 200.0};
+    /// volumeToMesh adaptivity: 0 = one vertex per surface voxel; larger merges flat regions into
+    /// larger triangles. 0.3 keeps the bunny's pieces at 400 mm near 3 MB of STL (docs/pieces.md).
+    double adaptivity = 0.3;
+};
+
+/// @throw Error(Usage) naming the option when a value is out of its documented range.
+void checkPiecesOptions(const PiecesOptions& options);
+
+/// One printable piece.
+struct Piece {
+    uint32_t id = 0;
+    std::vector<uint32_t> cells;      ///< cells it is cut from (sorted)
+    std::vector<uint32_t> requests;   ///< PieceRequest indices it comes from (sorted)
+    /// Pieces sharing a cut face, with the face's area (mm², first order in the voxel).
+    std::vector<std::pair<uint32_t, double>> neighbors;
+    uint32_t sliversMerged = 0;       ///< small components merged into this piece
+    double shellVolumeMm3 = 0.0;      ///< its part of the shell, counted in voxels
+
+    std::vector<Tenon> tenons;
+    /// When fewer than TenonOptions::minPerPiece tenons were found: why each candidate ray failed
+    /// ("hole holds a strut" → 3, ...); empty otherwise.
+    std::map<std::string, int> tenonShortfall;
+
+    std::optional<PieceLabel> label;  ///< the engraved number, when there was room
+    std::string labelNote;            ///< why there is no label
+
+    /// The printable mesh, in printer coordinates (on the bed z = 0, centred in x and y): closed,
+    /// 2-manifold, outward-oriented.
+    TriMesh mesh;
+    Transform4d gridToPrintMm;        ///< shell-grid mm → printer mm (a rotation and a translation)
+    bool isCutFaceDown = false;       ///< a planar cut face lies on the bed
+    Vec3d downNormalGridMm{0, 0, -1}; ///< the outward normal (grid mm) that points down when printed
+    Vec3d extentsMm{0, 0, 0};         ///< size of the printed piece along the printer's x, y, z
+    double volumeMm3 = 0.0;           ///< of the mesh
+    Box3d gridBoundsMm;               ///< of the mesh in the shell grid's mm
+};
+
+/// The result of makePieces.
+struct Pieces {
+    std::vector<Piece> pieces;
+    Vec3d printerMm{200, 200, 200};
+    double voxelMm = 0.0;
+    double shellVolumeMm3 = 0.0;        ///< the shell, counted in voxels
+    double outsideCellsVolumeMm3 = 0.0; ///< shell volume in cells no request names (own pieces)
+    size_t sliversMerged = 0;
+    size_t isolatedSlivers = 0;         ///< small pieces with no neighbour to merge into (kept)
+    Transform4d frameToGridMm;
+    Transform4d gridTransformMm;        ///< the shell's LevelSetInfo::transformMm (input mesh → grid mm)
+    PiecesOptions options;
+    double seconds = 0.0;
+};
+
+/// Cuts @p shell into printable pieces (paper §6).
+/// @param shell         the hollow shell level set (zf-shell), grid mm
+/// @param frame         the Zometool frame, frame mm
+/// @param frameToGridMm frame mm → grid mm: T_grid · T_frame⁻¹ of the two transform_mm; must be a
+///                      rotation plus a translation (the two were scaled alike)
+/// @param cells         the partition's cells, frame mm
+/// @param requests      the partition's pieces (cells in no request give pieces of their own)
+/// @throw Error(Usage) for bad options or a voxel too coarse for the tenon pegs;
+///        Error(InvalidInput) for an empty shell, a request naming an unknown cell, mismatched
+///        cell arrays, or a frameToGridMm that scales; Error(ProcessingFailed) when a piece fits
+///        the printer in no orientation (the partition must cut smaller), or a piece mesh is not
+///        closed; Error(Cancelled).
+Pieces makePieces(const sdf::LevelSet& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
+                  const CellModel& cells, const std::vector<PieceRequest>& requests, const PiecesOptions& options,
+                  RunContext& context);
+
+}  // namespace zomefab::pieces

@@ -1,0 +1,163 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// pieces.json, and the pieces' files written through a staging directory.
+#include "zomefab/pieces/pieces_io.h"
+
+#include <cmath>
+
+#include "zomefab/core/error.h"
+#include "zomefab/core/version.h"
+#include "zomefab/io/file_io.h"
+#include "zomefab/io/mesh_io.h"
+#include "zomefab/io/threemf.h"
+#include "zomefab/pieces/detail/vec.h"
+
+namespace zomefab::pieces {
+
+using nlohmann::json;
+
+namespace {
+
+json vec(const Vec3d& v) { return json::array({v[0], v[1], v[2]}); }
+json box(const Box3d& b) { return {{"min", vec(b.min)}, {"max", vec(b.max)}}; }
+json matrix(const Transform4d& t) {
+    json rows = json::array();
+    for (int r = 0; r < 4; ++r) rows.push_back({t.at(r, 0), t.at(r, 1), t.at(r, 2), t.at(r, 3)});
+    return rows;
+}
+
+}  // namespace
+
+std::string pieceFileName(const Pieces& pieces, size_t index) {
+    size_t width = 2;
+    for (size_t n = pieces.pieces.size(); n > 100; n /= 10) ++width;
+    std::string digits = std::to_string(index);
+    if (digits.size() < width) digits.insert(0, width - digits.size(), '0');
+    return "piece-" + digits + ".stl";
+}
+
+json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
+    const PiecesOptions& o = all.options;
+    json j;
+    j["format"] = kPiecesFormatName;
+    j["version"] = kPiecesFormatVersion;
+    j["generator"] = generatorString();
+    j["units"] = "mm";
+    j["inputs"] = {{"shell", info.shellFile}, {"frame", info.frameFile}, {"partition", info.partitionFile}};
+    j["printer_mm"] = vec(all.printerMm);
+    j["voxel_mm"] = all.voxelMm;
+    j["grid_transform_mm"] = matrix(all.gridTransformMm);
+    j["frame_to_grid_mm"] = matrix(all.frameToGridMm);
+    j["options"] = {{"min_piece_volume_mm3", o.minPieceVolumeMm3},
+                    {"adaptivity", o.adaptivity},
+                    {"tenons",
+                     {{"min_per_piece", o.tenons.minPerPiece},
+                      {"max_per_piece", o.tenons.maxPerPiece},
+                      {"clearance_mm", o.tenons.clearanceMm},
+                      {"hole_mm", {o.tenons.holeLongMm, o.tenons.holeShortMm}},
+                      {"peg_mm", {pegLongMm(o.tenons), pegShortMm(o.tenons)}},
+                      {"peg_depth_mm", o.tenons.pegDepthMm},
+                      {"width_mm", o.tenons.bodyWidthMm},
+                      {"max_length_mm", o.tenons.maxLengthMm},
+                      {"max_tilt_deg", o.tenons.maxTiltDeg},
+                      {"embed_mm", o.tenons.embedMm},
+                      {"frame_clearance_mm", o.tenons.frameClearanceMm}}},
+                    {"label",
+                     {{"enabled", o.label.isEnabled},
+                      {"height_mm", o.label.heightMm},
+                      {"stroke_mm", o.label.strokeMm},
+                      {"depth_mm", o.label.depthMm}}}};
+    double total = 0;
+    size_t tenonCount = 0, fewTenons = 0, labelled = 0;
+    json pieces = json::array();
+    for (size_t i = 0; i < all.pieces.size(); ++i) {
+        const Piece& p = all.pieces[i];
+        total += p.volumeMm3;
+        tenonCount += p.tenons.size();
+        if (p.tenons.size() < size_t(o.tenons.minPerPiece)) ++fewTenons;
+        if (p.label) ++labelled;
+        json neighbors = json::array();
+        for (const auto& [id, area] : p.neighbors) neighbors.push_back({{"piece", id}, {"contact_mm2", area}});
+        json tenons = json::array();
+        for (const Tenon& t : p.tenons) {
+            tenons.push_back({{"ball", t.ball},
+                              {"hole", t.hole},
+                              {"axis_frame", vec(t.axisFrame)},
+                              {"axis_mm", vec(t.axisGrid)},
+                              {"peg_long_side_mm", vec(t.longSideGrid)},
+                              {"ball_center_mm", vec(t.ballCenterGridMm)},
+                              {"peg_tip_mm", vec(t.pointAt(t.pegTipMm))},
+                              {"shoulder_mm", vec(t.pointAt(t.shoulderMm))},
+                              {"base_mm", vec(t.pointAt(t.baseMm))},
+                              {"end_mm", vec(t.pointAt(t.endMm))},
+                              {"length_mm", t.lengthMm()},
+                              {"tilt_deg", t.tiltDeg}});
+        }
+        json shortfall = nullptr;
+        if (p.tenons.size() < size_t(o.tenons.minPerPiece)) {
+            shortfall = {{"found", p.tenons.size()}, {"wanted", o.tenons.minPerPiece}, {"reasons", json::object()}};
+            for (const auto& [why, count] : p.tenonShortfall) shortfall["reasons"][why] = count;
+        }
+        json label = nullptr;
+        if (p.label)
+            label = {{"text", p.label->text},
+                     {"center_mm", vec(p.label->centerGridMm)},
+                     {"normal", vec(p.label->normalGrid)},
+                     {"up", vec(p.label->upGrid)},
+                     {"size_mm", {p.label->widthMm, p.label->heightMm}}};
+        Box3d printed = boundingBox(p.mesh);
+        pieces.push_back({{"piece", p.id},
+                          {"file", pieceFileName(all, i)},
+                          {"volume_mm3", p.volumeMm3},
+                          {"shell_volume_mm3", p.shellVolumeMm3},
+                          {"triangles", p.mesh.triangles.size()},
+                          {"bbox_mm", box(printed)},
+                          {"grid_bbox_mm", box(p.gridBoundsMm)},
+                          {"orientation",
+                           {{"transform_mm", matrix(p.gridToPrintMm)},
+                            {"cut_face_down", p.isCutFaceDown},
+                            {"down_normal", vec(p.downNormalGridMm)},
+                            {"extents_mm", vec(p.extentsMm)},
+                            {"fits", true}}},
+                          {"cells", p.cells},
+                          {"partition_pieces", p.requests},
+                          {"neighbors", neighbors},
+                          {"slivers_merged", p.sliversMerged},
+                          {"tenons", tenons},
+                          {"tenon_shortfall", shortfall},
+                          {"label", label},
+                          {"label_note", p.label ? json(nullptr) : json(p.labelNote)}});
+    }
+    j["pieces"] = pieces;
+    j["summary"] = {{"pieces", all.pieces.size()},
+                    {"volume_mm3", total},
+                    {"shell_volume_mm3", all.shellVolumeMm3},
+                    {"outside_cells_volume_mm3", all.outsideCellsVolumeMm3},
+                    {"slivers_merged", all.sliversMerged},
+                    {"isolated_slivers", all.isolatedSlivers},
+                    {"tenons", tenonCount},
+                    {"pieces_with_few_tenons", fewTenons},
+                    {"labelled", labelled}};
+    return j;
+}
+
+void writePieces(const Pieces& all, const std::string& directory, const PiecesJsonInfo& info) {
+    StagedDirectory staging(directory, "pieces.json");
+    std::vector<ThreeMfObject> objects;
+    // The 3MF lays the pieces out on a plate of bed-sized cells, 10 mm apart, row by row.
+    const size_t columns = size_t(std::ceil(std::sqrt(double(std::max<size_t>(all.pieces.size(), 1)))));
+    for (size_t i = 0; i < all.pieces.size(); ++i) {
+        const std::string name = pieceFileName(all, i);
+        writeMesh(all.pieces[i].mesh, staging.file(name));
+        const double dx = double(i % columns) * (all.printerMm[0] + 10.0);
+        const double dy = double(i / columns) * (all.printerMm[1] + 10.0);
+        objects.push_back({name.substr(0, name.size() - 4), &all.pieces[i].mesh,
+                           Transform4d::scaleTranslate(1.0, {dx, dy, 0.0})});
+    }
+    writeThreeMf(objects, generatorString(), staging.file("pieces.3mf"));
+    const std::string text = piecesToJson(all, info).dump(2) + "\n";
+    writeOutputAtomic(staging.file("pieces.json"),
+                      [&](std::ostream& out) { out.write(text.data(), std::streamsize(text.size())); });
+    staging.commit();
+}
+
+}  // namespace zomefab::pieces

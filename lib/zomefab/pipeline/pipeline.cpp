@@ -1,0 +1,197 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "zomefab/pipeline/pipeline.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <functional>
+
+#include "zomefab/core/error.h"
+#include "zomefab/core/version.h"
+#include "zomefab/frame/outermost.h"
+#include "zomefab/io/file_io.h"
+#include "zomefab/partition/partition_json.h"
+#include "zomefab/sdf/interior_field.h"
+#include "zomefab/zome/parts.h"
+#include "zomefab/zome/structure_json.h"
+
+namespace zomefab::pipeline {
+
+namespace {
+
+/// The file every zomefab output directory holds; its presence allows replacing the directory.
+constexpr const char* kReportFile = "report.json";
+
+/// Runs @p body as stage @p name: progress at its start and end, its wall time recorded.
+template <class Body>
+auto timedStage(const std::string& name, RunResult& result, RunContext& context, Body&& body) {
+    context.throwIfCancelled();
+    context.progress(name, 0.0);
+    Stopwatch clock;
+    auto value = body();
+    result.timings.push_back({name, clock.seconds()});
+    context.progress(name, 1.0);
+    return value;
+}
+
+/// Errors that stages raise about the object itself belong to the input file.
+[[noreturn]] void rethrowAboutInput(const Error& e, const std::string& sourceName) {
+    if (e.code() == ErrorCode::Usage || e.code() == ErrorCode::Cancelled || e.code() == ErrorCode::Internal)
+        throw e;
+    throw e.withFile(sourceName);
+}
+
+nlohmann::json transformJson(const Transform4d& t) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (int r = 0; r < 4; ++r) rows.push_back({t.at(r, 0), t.at(r, 1), t.at(r, 2), t.at(r, 3)});
+    return rows;
+}
+
+}  // namespace
+
+void checkRunOptions(const RunOptions& options) {
+    mesh::checkScaleOptions(options.scale);
+    sdf::checkObjectFieldOptions(options.field);
+    sdf::checkShellOptions(options.shell);
+    partition::checkPartitionOptions(options.partition, options.frame.lattice.scale);
+    if (options.frame.chains < 1) throw Error(ErrorCode::Usage, "--chains must be at least 1");
+}
+
+RunResult runPipeline(const TriMesh& input, const std::string& sourceName, const RunOptions& options,
+                      RunContext& context) {
+    checkRunOptions(options);
+    RunResult result;
+    result.sourceName = sourceName;
+    Stopwatch total;
+
+    // Stage 1: validate and scale (paper §3: the input is a closed mesh at its target size).
+    result.scaled = timedStage("input", result, context, [&] {
+        result.inputReport = mesh::checkMesh(input);
+        TriMesh valid = mesh::validateClosedMesh(input, options.validate, sourceName, context);
+        return mesh::scaleToMillimetres(std::move(valid), options.scale);
+    });
+
+    // Stage 2: level sets. The object grid must be exact as deep as the shell is thick.
+    sdf::ObjectFieldOptions fieldOptions = options.field;
+    fieldOptions.shellDepthMm = std::max(fieldOptions.shellDepthMm, options.shell.shellMm);
+    result.field = timedStage("level sets", result, context, [&] {
+        try {
+            sdf::ObjectField field = sdf::makeObjectField(result.scaled.mesh, fieldOptions, context);
+            for (sdf::LevelSet* levelSet : {&field.object, &field.interior}) {
+                levelSet->info().sourceFile = sourceName;
+                levelSet->info().generator = generatorString();
+                levelSet->info().transformMm = result.scaled.transformMm;
+            }
+            return field;
+        } catch (const Error& e) {
+            rethrowAboutInput(e, sourceName);
+        }
+    });
+    result.shell = timedStage("shell", result, context, [&] {
+        sdf::LevelSet shell = sdf::makeShell(result.field.object, options.shell, context);
+        shell.info().generator = generatorString();
+        return shell;
+    });
+
+    // Stage 4: the frame (paper §4), in the frame's millimetres (the lattice may be rotated).
+    const sdf::InteriorField interior = sdf::makeInteriorField(result.field.interior, context);
+    result.frame = timedStage("frame", result, context, [&] {
+        try {
+            return frame::buildFrame(interior, options.frame, context);
+        } catch (const Error& e) {
+            rethrowAboutInput(e, sourceName);
+        }
+    });
+    result.frameTransformMm = frame::frameTransformMm(result.scaled.transformMm, result.frame.rotationDeg);
+    {
+        const frame::FrameField frameField(interior, result.frame.rotationDeg, result.frame.structure.scale(),
+                                           options.frame.lattice.zone);
+        result.frameMetrics =
+            frame::measureFrame(result.frame.structure, frameField, options.frame.surfaceSampleSpacingMm);
+    }
+
+    // Stage 5: the surface partition (paper §5) of the outer surface, in frame coordinates.
+    result.surfaceFrameMm = result.scaled.mesh;
+    transformInPlace(result.surfaceFrameMm, frame::rotationAboutZ(-result.frame.rotationDeg));
+    result.partition = timedStage("partition", result, context, [&] {
+        partition::PartitionOptions partitionOptions = options.partition;
+        partitionOptions.seed = options.frame.seed;
+        try {
+            return partition::partitionSurface(result.surfaceFrameMm, result.frame.structure,
+                                               frame::outermostBalls(result.frame.structure), partitionOptions,
+                                               context);
+        } catch (const Error& e) {
+            rethrowAboutInput(e, sourceName);
+        }
+    });
+
+    result.totalSeconds = total.seconds();
+    return result;
+}
+
+nlohmann::json runReportJson(const RunResult& result, const RunOptions& options, const RunContext& context) {
+    nlohmann::json report;
+    report["format"] = "zomefab.report";
+    report["version"] = 1;
+    report["generator"] = generatorString();
+    report["input"] = {{"file", result.sourceName},
+                       {"triangles", result.inputReport.triangleCount},
+                       {"vertices", result.inputReport.vertexCount},
+                       {"size_mm", result.scaled.sizeMm},
+                       {"transform_mm", transformJson(result.scaled.transformMm)}};
+    report["level_sets"] = {
+        {"object", {{"voxel_mm", result.field.object.info().voxelMm},
+                    {"active_voxels", result.field.object.activeVoxelCount()}}},
+        {"interior", {{"voxel_mm", result.field.interior.info().voxelMm},
+                      {"active_voxels", result.field.interior.activeVoxelCount()}}},
+        {"shell", {{"shell_mm", options.shell.shellMm}, {"active_voxels", result.shell.activeVoxelCount()}}}};
+    const zome::PartsList parts = zome::partsList(result.frame.structure);
+    report["frame"] = {{"balls", parts.balls},
+                       {"struts", parts.strutTotal()},
+                       {"parts", zome::partsListToJson(parts)},
+                       {"energy_initial", result.frame.initialEnergy.total},
+                       {"energy_final", result.frame.finalEnergy.total},
+                       {"chains", options.frame.chains},
+                       {"rotation_deg", result.frame.rotationDeg},
+                       {"metrics", frame::metricsToJson(result.frameMetrics)}};
+    report["partition"] = {{"pieces", result.partition.pieces.size()},
+                           {"nearest_ball_partitions", result.partition.nearestPartitions},
+                           {"graph_cut_partitions", result.partition.graphCutPartitions},
+                           {"smoothness_weight", result.partition.smoothnessWeight},
+                           {"energy_nearest", result.partition.energyNearest},
+                           {"energy_graph_cut", result.partition.energyGraphCut},
+                           {"printer_mm", result.partition.printerMm}};
+    nlohmann::json timings = nlohmann::json::array();
+    for (const StageTiming& t : result.timings) timings.push_back({{"stage", t.stage}, {"seconds", t.seconds}});
+    report["timings"] = timings;
+    report["seconds"] = result.totalSeconds;
+    report["peak_rss_bytes"] = peakRssBytes();
+    report["warnings"] = context.warnings();
+    return report;
+}
+
+std::vector<std::string> writeRunOutputs(const RunResult& result, const RunOptions& options,
+                                         const nlohmann::json& report, const std::string& outDir) {
+    StagedDirectory staged(outDir, kReportFile);
+    std::vector<std::string> written;
+    auto write = [&](const std::string& name, const std::function<void(std::ostream&)>& body) {
+        writeOutputAtomic(staged.file(name), body);
+        written.push_back(name);
+    };
+    write("frame.json", [&](std::ostream& out) {
+        out << zome::structureToJson(result.frame.structure, result.frameTransformMm).dump(1) << '\n';
+    });
+    write("frame.vef", [&](std::ostream& out) { out << zome::structureToVef(result.frame.structure); });
+    write("partition.json", [&](std::ostream& out) {
+        partition::PartitionJsonInfo info;
+        info.meshFile = result.sourceName;
+        info.transformMm = result.frameTransformMm;
+        info.vertexCount = result.surfaceFrameMm.vertexCount();
+        out << partition::partitionToJson(result.partition, options.partition, info).dump(1) << '\n';
+    });
+    write(kReportFile, [&](std::ostream& out) { out << report.dump(2) << '\n'; });
+    staged.commit();
+    std::sort(written.begin(), written.end());
+    return written;
+}
+
+}  // namespace zomefab::pipeline

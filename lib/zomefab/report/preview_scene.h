@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file The `preview.glb` scene: printed pieces (Draco-compressed, one node and colour each), the
+/// Zometool balls (one white sphere mesh instanced by every ball node) and struts (one prism mesh
+/// per colour and size with the real cross-section, instanced), under a root node that turns the
+/// model's millimetres and z-up into glTF's metres and y-up. Layout: docs/preview.md.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "zomefab/core/tri_mesh.h"
+#include "zomefab/io/glb_write.h"
+#include "zomefab/zome/structure.h"
+
+namespace zomefab::report {
+
+/// What the preview shows. Everything in the model's millimetres, z up.
+struct PreviewInput {
+    std::vector<TriMesh> pieces;          ///< closed piece meshes where they sit in the model
+    std::vector<std::string> pieceNames;  ///< node names, one per piece; empty = "piece-00", ...
+    const zome::Structure* frame = nullptr;  ///< the Zometool frame; null = pieces only
+    /// Merged into scenes[0].extras next to the parts list (e.g. the run's summary); null = none.
+    nlohmann::json extras;
+};
+
+struct PreviewOptions {
+    int sphereSubdivisions = 2;         ///< icosphere levels of the ball mesh: 2 = 320 triangles
+    bool isPieceDracoCompressed = true;  ///< KHR_draco_mesh_compression on the pieces
+    GlbWriteOptions glb;                 ///< Draco quantisation and speed
+    std::string generator;               ///< asset.generator; empty = "zomefab <version>"
+};
+
+/// Cross-section of a strut as a convex polygon (counter-clockwise, mm) in the plane normal to
+/// the strut: x points along the "long" direction chosen by strutCrossSectionFrame(). Blue: the
+/// golden rectangle 5.46 × 3.38 mm; yellow: the equilateral triangle of edge 5.46 mm (circumradius
+/// 3.15 mm); red: the regular pentagon of circumradius 2.87 mm (docs/zome.md §3, vZome's models).
+std::vector<std::array<double, 2>> strutCrossSection(zome::Color color);
+
+/// Unit vector normal to hole @p hole's direction that the cross-section's x axis follows: towards
+/// the nearest red axis for blue (the rectangle's long side) and yellow (a triangle corner), towards
+/// the nearest yellow axis for red (a pentagon corner), as on the Zome ball, whose holes are the faces
+/// of a small rhombicosidodecahedron (vertex figure triangle–rectangle–pentagon–rectangle).
+Vec3d strutCrossSectionFrame(int hole);
+
+/// Builds the scene. Node names: "piece-NN" (or pieceNames), "ball-<id>", "strut-<id>" with the
+/// frame's ids; group nodes "zomefab" (root), "pieces", "balls", "struts".
+/// @throw Error(Usage) when pieceNames has the wrong size, a piece is empty, or the frame's ball is
+///   at least as wide as its shortest strut is long.
+GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& options = {});
+
+/// buildPreviewScene() then writeGlb(), atomically. @throw as both.
+void writePreview(const PreviewInput& input, const std::string& path, const PreviewOptions& options = {});
+
+}  // namespace zomefab::report

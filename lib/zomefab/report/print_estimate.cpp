@@ -1,0 +1,174 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "zomefab/report/print_estimate.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "zomefab/core/error.h"
+#include "zomefab/report/mesh_clip.h"
+
+namespace zomefab::report {
+
+namespace {
+
+void requirePositive(double value, const char* option) {
+    if (!(value > 0.0) || !std::isfinite(value))
+        throw Error(ErrorCode::Usage, std::string(option) + " must be a positive number, got " + std::to_string(value));
+}
+
+}  // namespace
+
+void PrintSettings::validate() const {
+    requirePositive(layerHeightMm, "layer height");
+    requirePositive(firstLayerHeightMm, "first layer height");
+    requirePositive(nozzleMm, "nozzle diameter");
+    requirePositive(extrusionWidthMm, "extrusion width");
+    if (perimeters < 1) throw Error(ErrorCode::Usage, "perimeters must be at least 1");
+    if (topLayers < 0 || bottomLayers < 0) throw Error(ErrorCode::Usage, "top/bottom layers must not be negative");
+    if (!(infillPercent > 0.0 && infillPercent <= 100.0))
+        throw Error(ErrorCode::Usage, "infill must be in (0, 100] percent, got " + std::to_string(infillPercent));
+}
+
+void FilamentOptions::validate() const {
+    requirePositive(diameterMm, "--filament-mm");
+    requirePositive(densityGPerCm3, "--filament-density");
+    if (!(usdPerM >= 0.0) || !std::isfinite(usdPerM))
+        throw Error(ErrorCode::Usage, "--filament-usd-per-m must not be negative, got " + std::to_string(usdPerM));
+}
+
+PrintEstimate& PrintEstimate::operator+=(const PrintEstimate& o) {
+    seconds += o.seconds;
+    filamentMm3 += o.filamentMm3;
+    partVolumeMm3 += o.partVolumeMm3;
+    externalPerimeterMm3 += o.externalPerimeterMm3;
+    innerPerimeterMm3 += o.innerPerimeterMm3;
+    solidMm3 += o.solidMm3;
+    infillMm3 += o.infillMm3;
+    layers += o.layers;
+    parts += o.parts;
+    return *this;
+}
+
+FilamentUse filamentUse(double filamentMm3, const FilamentOptions& filament) {
+    const double pi = std::acos(-1.0);
+    const double crossSectionMm2 = 0.25 * pi * filament.diameterMm * filament.diameterMm;
+    FilamentUse use;
+    use.lengthM = filamentMm3 / crossSectionMm2 / 1000.0;
+    use.massG = filamentMm3 / 1000.0 * filament.densityGPerCm3;
+    use.costUsd = use.lengthM * filament.usdPerM;
+    return use;
+}
+
+PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const PrintRates& rates) {
+    s.validate();
+    PrintEstimate e;
+    e.parts = 1;
+    if (part.triangles.empty()) return e;
+    const double pi = std::acos(-1.0);
+    const double h = s.layerHeightMm, w = s.extrusionWidthMm;
+    // Centre-line spacing of adjacent perimeters (PrusaSlicer's flow model: a rectangle with
+    // semicircular ends, so neighbours overlap by h·(1 − π/4)).
+    const double spacing = w - h * (1.0 - 0.25 * pi);
+    const double wallMm = w + double(s.perimeters - 1) * spacing;  // t_w, horizontal
+    const double topMm = double(s.topLayers) * h;                   // t_s above
+    const double bottomMm =
+        s.bottomLayers > 0 ? s.firstLayerHeightMm + double(s.bottomLayers - 1) * h : 0.0;  // t_s below
+
+    double perimeterMm3 = 0.0, solidMm3 = 0.0, zMin = 1e300, zMax = -1e300;
+    for (const Vec3f& p : part.positions) zMin = std::min(zMin, double(p[2])), zMax = std::max(zMax, double(p[2]));
+    for (const Triangle& t : part.triangles) {
+        const Vec3f &a = part.positions[t[0]], &b = part.positions[t[1]], &c = part.positions[t[2]];
+        const double ux = double(b[0]) - a[0], uy = double(b[1]) - a[1], uz = double(b[2]) - a[2];
+        const double vx = double(c[0]) - a[0], vy = double(c[1]) - a[1], vz = double(c[2]) - a[2];
+        const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+        const double twiceArea = std::sqrt(nx * nx + ny * ny + nz * nz);
+        if (twiceArea == 0.0) continue;
+        const double area = 0.5 * twiceArea;
+        const double cosZ = nz / twiceArea;
+        const double sinZ = std::sqrt(std::max(0.0, 1.0 - cosZ * cosZ));
+        // Normal-direction thickness of the perimeters (horizontal t_w) and of the solid layers
+        // (vertical t_s); where both apply the thicker one wins, the solid layers only add the rest.
+        const double wall = wallMm * sinZ;
+        const double skin = (cosZ > 0.0 ? topMm : bottomMm) * std::abs(cosZ);
+        perimeterMm3 += area * wall;
+        solidMm3 += area * std::max(0.0, skin - wall);
+    }
+    const double volume = std::max(0.0, meshVolumeMm3(part));
+    const double shell = perimeterMm3 + solidMm3;
+    if (shell > volume && shell > 0.0) {
+        // Walls thinner than two shells: everything is perimeter or solid layer.
+        perimeterMm3 *= volume / shell;
+        solidMm3 *= volume / shell;
+    }
+    const double interior = std::max(0.0, volume - perimeterMm3 - solidMm3);
+    const bool isSolid = s.infillPercent >= 100.0;
+    e.partVolumeMm3 = volume;
+    e.externalPerimeterMm3 = perimeterMm3 * (w / wallMm);
+    e.innerPerimeterMm3 = perimeterMm3 - e.externalPerimeterMm3;
+    e.solidMm3 = solidMm3;
+    e.infillMm3 = isSolid ? interior : interior * std::min(1.0, 0.01 * s.infillPercent * rates.sparseInfillFactor);
+    e.filamentMm3 = perimeterMm3 + solidMm3 + e.infillMm3;
+    const double height = zMax - zMin;
+    e.layers = height <= s.firstLayerHeightMm ? 1 : 1 + size_t(std::ceil((height - s.firstLayerHeightMm) / h - 1e-9));
+    e.seconds = e.externalPerimeterMm3 * rates.externalPerimeterSPerMm3 +
+                e.innerPerimeterMm3 * rates.innerPerimeterSPerMm3 + e.solidMm3 * rates.solidSPerMm3 +
+                e.infillMm3 * (isSolid ? rates.solidInfillSPerMm3 : rates.sparseInfillSPerMm3) +
+                double(e.layers) * rates.layerS;
+    return e;
+}
+
+bool fitsPrinter(const Vec3d& sizeMm, const Vec3d& printerMm) {
+    std::array<double, 3> a{sizeMm[0], sizeMm[1], sizeMm[2]}, b{printerMm[0], printerMm[1], printerMm[2]};
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    // Sorted sizes against sorted sizes: the best of the six axis permutations.
+    for (int i = 0; i < 3; ++i)
+        if (a[size_t(i)] > b[size_t(i)] + 1e-6) return false;
+    return true;
+}
+
+namespace {
+
+void splitUntilFits(const TriMesh& part, const Box3d& cell, const Vec3d& printerMm, int depthLeft,
+                    std::vector<TriMesh>& out, RunContext& context) {
+    context.throwIfCancelled();
+    if (part.triangles.empty()) return;
+    if (fitsPrinter(boundingBox(part).size(), printerMm)) {
+        out.push_back(part);
+        return;
+    }
+    if (depthLeft == 0)
+        throw Error(ErrorCode::Usage, "the baseline cannot cut the object into parts that fit the printer "
+                                      "(octree too deep); is --printer-mm far too small?");
+    const Vec3d mid{0.5 * (cell.min[0] + cell.max[0]), 0.5 * (cell.min[1] + cell.max[1]),
+                    0.5 * (cell.min[2] + cell.max[2])};
+    // Octants in x-major order: x halves, then y halves of each, then z halves.
+    for (int ix = 0; ix < 2; ++ix) {
+        const TriMesh px = clipByPlane(part, 0, mid[0], ix == 0);
+        if (px.triangles.empty()) continue;
+        for (int iy = 0; iy < 2; ++iy) {
+            const TriMesh py = clipByPlane(px, 1, mid[1], iy == 0);
+            if (py.triangles.empty()) continue;
+            for (int iz = 0; iz < 2; ++iz) {
+                const TriMesh pz = clipByPlane(py, 2, mid[2], iz == 0);
+                Box3d child;
+                child.min = {ix ? mid[0] : cell.min[0], iy ? mid[1] : cell.min[1], iz ? mid[2] : cell.min[2]};
+                child.max = {ix ? cell.max[0] : mid[0], iy ? cell.max[1] : mid[1], iz ? cell.max[2] : mid[2]};
+                splitUntilFits(pz, child, printerMm, depthLeft - 1, out, context);
+            }
+        }
+    }
+}
+
+}  // namespace
+
+std::vector<TriMesh> octreeParts(const TriMesh& object, const Vec3d& printerMm, int maxDepth, RunContext& context) {
+    for (int i = 0; i < 3; ++i) requirePositive(printerMm[size_t(i)], "--printer-mm");
+    std::vector<TriMesh> parts;
+    splitUntilFits(object, boundingBox(object), printerMm, maxDepth, parts, context);
+    return parts;
+}
+
+}  // namespace zomefab::report

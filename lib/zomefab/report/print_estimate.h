@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file Print time and filament of a closed part without a slicer: a shell/infill volume model
+/// over the mesh's facets, timed with volumetric rates fitted to PrusaSlicer 2.5 (the model and
+/// its calibration table: docs/report.md). Also the octree cut of the paper's baseline (§7.2) and
+/// filament length, mass and cost.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "zomefab/core/run_context.h"
+#include "zomefab/core/tri_mesh.h"
+
+namespace zomefab::report {
+
+/// The slicer profile the numbers refer to: ../shared/docs/print-estimates.md's Ultimaker-3-like
+/// profile (0.4 mm nozzle, 0.2 mm layers, 3 perimeters, 5 top and 5 bottom layers).
+struct PrintSettings {
+    double layerHeightMm = 0.2;
+    double firstLayerHeightMm = 0.27;
+    double nozzleMm = 0.4;
+    /// Extrusion width; PrusaSlicer's automatic width is 1.125 × nozzle.
+    double extrusionWidthMm = 0.45;
+    int perimeters = 3;
+    int topLayers = 5;
+    int bottomLayers = 5;
+    double infillPercent = 20.0;  ///< sparse infill density; 100 = solid (paper §7.2 "solid")
+
+    /// @throw Error(Usage) naming the option for non-positive sizes or infill outside (0, 100].
+    void validate() const;
+};
+
+/// Rates of the time model and the infill factor: seconds per mm³ of each extrusion kind plus a
+/// fixed cost per layer. Defaults are the least-squares fit to PrusaSlicer 2.5.0 on the
+/// calibration parts of docs/report.md (tests/report/report_calibration.cpp re-runs the fit).
+struct PrintRates {
+    double externalPerimeterSPerMm3 = 0.34;  ///< outermost loop, half the perimeter speed
+    double innerPerimeterSPerMm3 = 0.19;     ///< the other loops
+    double solidSPerMm3 = 0.46;              ///< top and bottom solid layers (20 mm/s in PrusaSlicer)
+    double sparseInfillSPerMm3 = 0.16;       ///< sparse infill below 100 %
+    double solidInfillSPerMm3 = 0.16;        ///< interior at 100 % infill (still at infill speed)
+    double layerS = 1.0;                     ///< per layer: travel, z move, retractions
+    /// Filament in sparse infill per mm³ of interior and per unit of density (1 = the nominal %).
+    double sparseInfillFactor = 1.0;
+};
+
+/// Filament and its price. Default: the paper's 0.56 USD per metre of 2.85 mm PLA (§7.2).
+struct FilamentOptions {
+    double diameterMm = 2.85;
+    double densityGPerCm3 = 1.24;  ///< PLA
+    double usdPerM = 0.56;
+    /// @throw Error(Usage) naming the option for non-positive values (a free filament is allowed).
+    void validate() const;
+};
+
+/// Time and material of one part or a set of parts.
+struct PrintEstimate {
+    double seconds = 0.0;
+    double filamentMm3 = 0.0;  ///< volume of plastic extruded
+    // The model's breakdown (zero when the numbers come from a slicer):
+    double partVolumeMm3 = 0.0;
+    double externalPerimeterMm3 = 0.0;
+    double innerPerimeterMm3 = 0.0;
+    double solidMm3 = 0.0;     ///< top/bottom solid layers
+    double infillMm3 = 0.0;    ///< plastic in the interior
+    size_t layers = 0;         ///< summed over parts
+    size_t parts = 0;
+
+    double hours() const { return seconds / 3600.0; }
+    PrintEstimate& operator+=(const PrintEstimate& o);
+};
+
+/// Length, mass and price of @p filamentMm3 of filament.
+struct FilamentUse {
+    double lengthM = 0.0;
+    double massG = 0.0;
+    double costUsd = 0.0;
+};
+FilamentUse filamentUse(double filamentMm3, const FilamentOptions& filament);
+
+/// Estimates printing the closed, outward part @p part (mm, z up, as it will be printed).
+/// The model (docs/report.md): per facet of area A and unit normal n, the perimeters occupy
+/// A·t_w·sin θ and the top/bottom solid layers A·max(0, t_s·|cos θ| − t_w·sin θ), with
+/// t_w = w + (perimeters − 1)·(w − h(1 − π/4)) and t_s the solid layers' height; both are scaled
+/// down together when they exceed the part's volume (thin parts are solid). The rest of the volume
+/// is infill at the given density. Time = Σ volume·rate + layers·layerS. O(F), deterministic.
+PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& settings, const PrintRates& rates = {});
+
+/// The parts of the paper's baseline (§7.2): the object's bounding box is split as an octree and
+/// each cell's part (the object clipped to the cell, capped) is split again until it fits the
+/// printer in one of the six axis-aligned orientations. Empty cells are dropped; parts come in
+/// octant order. @throw Error(Usage) when @p printerMm has a non-positive size or a part still
+/// does not fit after @p maxDepth levels; as clipByPlane() for an open mesh.
+std::vector<TriMesh> octreeParts(const TriMesh& object, const Vec3d& printerMm, int maxDepth = 10,
+                                 RunContext& context = RunContext::silent());
+
+/// True when a box of size @p sizeMm fits in @p printerMm after some axis permutation.
+bool fitsPrinter(const Vec3d& sizeMm, const Vec3d& printerMm);
+
+}  // namespace zomefab::report

@@ -1,0 +1,225 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "zomefab/report/slicer.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "zomefab/core/error.h"
+#include "zomefab/io/mesh_io.h"
+
+extern char** environ;
+
+namespace zomefab::report {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string formatNumber(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.10g", v);
+    return buf;
+}
+
+/// Removes the scratch directory however the slicing ends.
+struct ScratchDir {
+    fs::path path;
+    ~ScratchDir() {
+        std::error_code ec;
+        if (!path.empty()) fs::remove_all(path, ec);
+    }
+};
+
+std::string lastLine(const fs::path& log) {
+    std::ifstream in(log);
+    std::string line, last;
+    while (std::getline(in, line)) {
+        while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+        if (!line.empty()) last = line;
+    }
+    return last.empty() ? "no message" : last;
+}
+
+/// The value after "= " of the last line starting with @p prefix in @p text, or empty.
+std::string commentValue(const std::string& text, const std::string& prefix) {
+    size_t at = std::string::npos, from = 0;
+    while ((from = text.find(prefix, from)) != std::string::npos) {
+        if (from == 0 || text[from - 1] == '\n') at = from;
+        from += prefix.size();
+    }
+    if (at == std::string::npos) return {};
+    const size_t eq = text.find("= ", at);
+    const size_t end = text.find('\n', at);
+    if (eq == std::string::npos || (end != std::string::npos && eq > end)) return {};
+    return text.substr(eq + 2, end == std::string::npos ? std::string::npos : end - eq - 2);
+}
+
+}  // namespace
+
+bool isSlicerAvailable(const std::string& executable) {
+    if (executable.empty()) return false;
+    if (executable.find('/') != std::string::npos) return ::access(executable.c_str(), X_OK) == 0;
+    const char* path = std::getenv("PATH");
+    if (!path) return false;
+    std::stringstream dirs(path);
+    std::string dir;
+    while (std::getline(dirs, dir, ':')) {
+        if (dir.empty()) dir = ".";
+        const std::string candidate = dir + "/" + executable;
+        struct stat st {};
+        if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(candidate.c_str(), X_OK) == 0)
+            return true;
+    }
+    return false;
+}
+
+std::vector<std::string> prusaSlicerArguments(const PrintSettings& s, double bedMm) {
+    const std::string bed = formatNumber(bedMm);
+    // PrusaSlicer refuses the "triangles" pattern at 100 % ("not supposed to work at 100%
+    // density"); its solid infill is rectilinear.
+    const bool isSolid = s.infillPercent >= 100.0;
+    std::vector<std::string> args = {"--loglevel", "1",
+                                     "--export-gcode",
+                                     "--layer-height", formatNumber(s.layerHeightMm),
+                                     "--first-layer-height", formatNumber(s.firstLayerHeightMm),
+                                     "--nozzle-diameter", formatNumber(s.nozzleMm),
+                                     "--filament-diameter", "2.85",
+                                     "--filament-density", "1.24",
+                                     "--fill-density", formatNumber(std::min(100.0, s.infillPercent)) + "%",
+                                     "--fill-pattern", isSolid ? "rectilinear" : "triangles",
+                                     "--perimeters", std::to_string(s.perimeters),
+                                     "--top-solid-layers", std::to_string(s.topLayers),
+                                     "--bottom-solid-layers", std::to_string(s.bottomLayers),
+                                     "--gcode-flavor", "marlin2",
+                                     "--machine-limits-usage", "time_estimate_only",
+                                     "--bed-shape", "0x0," + bed + "x0," + bed + "x" + bed + ",0x" + bed,
+                                     "--max-print-height", bed};
+    // PrusaSlicer's automatic width is 1.125 × nozzle; anything else is passed explicitly.
+    if (std::abs(s.extrusionWidthMm - 1.125 * s.nozzleMm) > 1e-9) {
+        args.push_back("--extrusion-width");
+        args.push_back(formatNumber(s.extrusionWidthMm));
+    }
+    return args;
+}
+
+double parseSlicerDuration(const std::string& text) {
+    std::istringstream in(text);
+    std::string token;
+    double seconds = 0.0;
+    bool any = false;
+    while (in >> token) {
+        if (token.size() < 2) return -1.0;
+        const char unit = token.back();
+        const std::string number = token.substr(0, token.size() - 1);
+        char* end = nullptr;
+        const double v = std::strtod(number.c_str(), &end);
+        if (end != number.c_str() + number.size() || !(v >= 0.0)) return -1.0;
+        switch (unit) {
+            case 'd': seconds += v * 86400.0; break;
+            case 'h': seconds += v * 3600.0; break;
+            case 'm': seconds += v * 60.0; break;
+            case 's': seconds += v; break;
+            default: return -1.0;
+        }
+        any = true;
+    }
+    return any ? seconds : -1.0;
+}
+
+PrintEstimate sliceWithPrusaSlicer(const TriMesh& part, const PrintSettings& settings, const std::string& label,
+                                   const SlicerOptions& options, RunContext& context) {
+    settings.validate();
+    if (!isSlicerAvailable(options.executable))
+        throw Error(ErrorCode::ProcessingFailed,
+                    "slicer '" + options.executable + "' not found (Debian package prusa-slicer)");
+    if (part.triangles.empty()) throw Error(ErrorCode::ProcessingFailed, label + ": nothing to slice");
+
+    std::error_code ec;
+    const fs::path parent = options.tempDir.empty() ? fs::temp_directory_path(ec) : fs::path(options.tempDir);
+    std::string pattern = (parent / "zomefab-slice-XXXXXX").string();
+    if (!::mkdtemp(pattern.data()))
+        throw Error(ErrorCode::WriteFailed, std::string("cannot create a scratch directory: ") + std::strerror(errno),
+                    parent.string());
+    ScratchDir scratch{fs::path(pattern)};
+    const fs::path stl = scratch.path / "part.stl", gcode = scratch.path / "part.gcode", log = scratch.path / "slicer.log";
+    writeMesh(part, stl.string());
+
+    const Box3d box = boundingBox(part);
+    const Vec3d size = box.size();
+    const double bedMm = std::max(1000.0, 2.0 * std::max({size[0], size[1], size[2]}));
+    std::vector<std::string> args = {options.executable};
+    for (std::string& a : prusaSlicerArguments(settings, bedMm)) args.push_back(std::move(a));
+    args.insert(args.end(), {"-o", gcode.string(), stl.string()});
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+
+    // posix_spawn, not fork: safe in a process with TBB worker threads.
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    pid_t pid = 0;
+    const int spawned = ::posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (spawned != 0)
+        throw Error(ErrorCode::ProcessingFailed,
+                    "cannot start '" + options.executable + "': " + std::strerror(spawned));
+    int status = 0;
+    for (;;) {
+        const pid_t r = ::waitpid(pid, &status, WNOHANG);
+        if (r == pid) break;
+        if (r < 0 && errno != EINTR)
+            throw Error(ErrorCode::ProcessingFailed, "lost the slicer process: " + std::string(std::strerror(errno)));
+        if (context.isCancelled()) {
+            ::kill(pid, SIGTERM);
+            ::waitpid(pid, &status, 0);
+            context.throwIfCancelled();
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        throw Error(ErrorCode::ProcessingFailed,
+                    options.executable + " failed on " + label + ": " + lastLine(log));
+
+    // The estimates are comments near the end of the G-code, before the configuration block.
+    std::ifstream in(gcode, std::ios::binary | std::ios::ate);
+    if (!in) throw Error(ErrorCode::ProcessingFailed, options.executable + " wrote no G-code for " + label);
+    const std::streamoff length = in.tellg();
+    const std::streamoff tail = std::min<std::streamoff>(length, 1 << 20);
+    std::string text(size_t(tail), '\0');
+    in.seekg(length - tail);
+    in.read(text.data(), tail);
+
+    const double seconds = parseSlicerDuration(commentValue(text, "; estimated printing time (normal mode)"));
+    const std::string cm3 = commentValue(text, "; filament used [cm3]");
+    char* end = nullptr;
+    const double filamentCm3 = std::strtod(cm3.c_str(), &end);
+    if (seconds < 0.0 || cm3.empty() || end == cm3.c_str() || !(filamentCm3 >= 0.0))
+        throw Error(ErrorCode::ProcessingFailed,
+                    options.executable + " printed no time or filament estimate for " + label);
+    PrintEstimate e;
+    e.seconds = seconds;
+    e.filamentMm3 = filamentCm3 * 1000.0;
+    e.parts = 1;
+    return e;
+}
+
+}  // namespace zomefab::report
