@@ -8,6 +8,8 @@
 ///       round-trip Hausdorff (95th percentile and max) for several voxel sizes, and the interior
 ///       field's depth and closest-point errors for several field voxels, against the exact
 ///       distance to the input triangles (--field-accuracy: only the interior field part).
+#include <time.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -17,8 +19,6 @@
 #include <random>
 #include <string>
 #include <vector>
-
-#include <time.h>
 
 #include "mesh_distance.h"
 #include "zomefab/core/error.h"
@@ -53,17 +53,27 @@ Args parse(int argc, char** argv) {
             if (i + 1 >= argc) throw Error(ErrorCode::Usage, s + " needs a value");
             return std::atof(argv[++i]);
         };
-        if (s == "--height-mm") a.heightMm = next();
-        else if (s == "--voxel-mm") a.voxelMm = next();
-        else if (s == "--shell-mm") a.shellMm = next();
-        else if (s == "--field-voxel-mm") a.fieldVoxelMm = next();
-        else if (s == "--up" && i + 1 < argc) a.isYUp = std::string(argv[++i]) == "y";
-        else if (s == "--accuracy") a.isAccuracy = true;
-        else if (s == "--field-accuracy") a.isAccuracy = a.isFieldOnly = true;
-        else if (!s.empty() && s[0] != '-') a.mesh = s;
-        else throw Error(ErrorCode::Usage, "unknown argument " + s);
+        if (s == "--height-mm")
+            a.heightMm = next();
+        else if (s == "--voxel-mm")
+            a.voxelMm = next();
+        else if (s == "--shell-mm")
+            a.shellMm = next();
+        else if (s == "--field-voxel-mm")
+            a.fieldVoxelMm = next();
+        else if (s == "--up" && i + 1 < argc)
+            a.isYUp = std::string(argv[++i]) == "y";
+        else if (s == "--accuracy")
+            a.isAccuracy = true;
+        else if (s == "--field-accuracy")
+            a.isAccuracy = a.isFieldOnly = true;
+        else if (!s.empty() && s[0] != '-')
+            a.mesh = s;
+        else
+            throw Error(ErrorCode::Usage, "unknown argument " + s);
     }
-    if (a.mesh.empty()) throw Error(ErrorCode::Usage, "usage: bench_sdf MESH --height-mm H [--up y] [--accuracy]");
+    if (a.mesh.empty())
+        throw Error(ErrorCode::Usage, "usage: bench_sdf MESH --height-mm H [--up y] [--accuracy]");
     return a;
 }
 
@@ -91,7 +101,8 @@ std::vector<Vec3d> interiorPoints(const sdf::InteriorField& field, size_t count,
     std::uniform_real_distribution<double> u(0.0, 1.0);
     std::vector<Vec3d> points;
     while (points.size() < count) {
-        const Vec3d p{box.min[0] + u(rng) * (box.max[0] - box.min[0]), box.min[1] + u(rng) * (box.max[1] - box.min[1]),
+        const Vec3d p{box.min[0] + u(rng) * (box.max[0] - box.min[0]),
+                      box.min[1] + u(rng) * (box.max[1] - box.min[1]),
                       box.min[2] + u(rng) * (box.max[2] - box.min[2])};
         if (field.isInside(p)) points.push_back(p);
     }
@@ -105,8 +116,8 @@ void runSteps(const Args& args) {
     mesh::ScaleOptions scale;
     scale.heightMm = args.heightMm;
     scale.up = args.isYUp ? mesh::UpAxis::Y : mesh::UpAxis::Z;
-    const mesh::ScaledMesh scaled =
-        mesh::scaleToMillimetres(mesh::validateClosedMesh(readMesh(args.mesh), {}, args.mesh, context), scale);
+    const mesh::ScaledMesh scaled = mesh::scaleToMillimetres(
+        mesh::validateClosedMesh(readMesh(args.mesh), {}, args.mesh, context), scale);
     const double readSeconds = clock.wall.seconds(), readCpu = clock.cpu();
 
     sdf::ObjectFieldOptions objectOptions;
@@ -155,7 +166,8 @@ void runSteps(const Args& args) {
     double t0 = cpuSeconds(CLOCK_THREAD_CPUTIME_ID);
     for (int r = 0; r < rounds; ++r)
         for (const Vec3d& p : points) sink += field.signedDistanceMm(p);
-    const double distanceNs = (cpuSeconds(CLOCK_THREAD_CPUTIME_ID) - t0) * 1e9 / (double(rounds) * double(points.size()));
+    const double distanceNs =
+        (cpuSeconds(CLOCK_THREAD_CPUTIME_ID) - t0) * 1e9 / (double(rounds) * double(points.size()));
     t0 = cpuSeconds(CLOCK_THREAD_CPUTIME_ID);
     for (int r = 0; r < rounds / 8; ++r)
         for (const Vec3d& p : points) sink += field.closestSurfacePointMm(p)[0];
@@ -168,32 +180,39 @@ void runSteps(const Args& args) {
         if (!std::fgets(load, sizeof(load), f)) load[0] = 0;
         std::fclose(f);
     }
-    std::printf("mesh %s at %.0f mm (%.1f x %.1f x %.1f mm), %zu triangles; load average %s", args.mesh.c_str(),
-                args.heightMm, scaled.sizeMm[0], scaled.sizeMm[1], scaled.sizeMm[2], scaled.mesh.triangleCount(), load);
+    std::printf("mesh %s at %.0f mm (%.1f x %.1f x %.1f mm), %zu triangles; load average %s",
+                args.mesh.c_str(), args.heightMm, scaled.sizeMm[0], scaled.sizeMm[1], scaled.sizeMm[2],
+                scaled.mesh.triangleCount(), load);
     std::printf("step                          wall s   CPU s\n");
     std::printf("read+validate+scale          %6.2f  %6.2f\n", readSeconds, readCpu);
-    std::printf("object (%g mm, %g mm deep)   %6.2f  %6.2f  %10zu active voxels  %7.1f MB\n", object.info().voxelMm,
-                objectOptions.shellDepthMm, objectSeconds, objectCpu, object.activeVoxelCount(),
-                megabytes(object.memoryBytes()));
-    std::printf("interior (%g mm, whole)      %6.2f  %6.2f  %10zu active voxels  %7.1f MB\n", interior.info().voxelMm,
-                interiorSeconds, interiorCpu, interior.activeVoxelCount(), megabytes(interior.memoryBytes()));
+    std::printf("object (%g mm, %g mm deep)   %6.2f  %6.2f  %10zu active voxels  %7.1f MB\n",
+                object.info().voxelMm, objectOptions.shellDepthMm, objectSeconds, objectCpu,
+                object.activeVoxelCount(), megabytes(object.memoryBytes()));
+    std::printf("interior (%g mm, whole)      %6.2f  %6.2f  %10zu active voxels  %7.1f MB\n",
+                interior.info().voxelMm, interiorSeconds, interiorCpu, interior.activeVoxelCount(),
+                megabytes(interior.memoryBytes()));
     std::printf("serialize object.vdb         %6.2f  %6.2f  %7.1f MB\n", writeSeconds, writeCpu,
                 megabytes(objectBytes.size()));
-    std::printf("shell (%g mm)                %6.2f  %6.2f  %10zu active voxels\n", args.shellMm, shellSeconds, shellCpu,
-                shell.activeVoxelCount());
+    std::printf("shell (%g mm)                %6.2f  %6.2f  %10zu active voxels\n", args.shellMm,
+                shellSeconds, shellCpu, shell.activeVoxelCount());
     std::printf("shell mesh                   %6.2f  %6.2f  %10zu triangles\n", meshSeconds, meshCpu,
                 shellMesh.triangleCount());
-    std::printf("mesh -> shell mesh total     %6.2f  %6.2f  (in process, incl. the interior grid)\n", pipelineSeconds,
-                pipelineCpu);
+    std::printf("mesh -> shell mesh total     %6.2f  %6.2f  (in process, incl. the interior grid)\n",
+                pipelineSeconds, pipelineCpu);
     std::printf("interior field (dense)       %6.2f  %6.2f  %7.1f MB\n", fieldSeconds, fieldCpu,
                 megabytes(field.memoryBytes()));
-    std::printf("query (thread CPU): signedDistanceMm %.1f ns, closestSurfacePointMm %.1f ns (F(p0) = %.1f, sink %g)\n",
-                distanceNs, closestNs, forbiddenSample, sink > 0 ? 1.0 : 0.0);
+    std::printf(
+        "query (thread CPU): signedDistanceMm %.1f ns, closestSurfacePointMm %.1f ns (F(p0) = %.1f, sink "
+        "%g)\n",
+        distanceNs, closestNs, forbiddenSample, sink > 0 ? 1.0 : 0.0);
     std::printf("peak RSS %.0f MB\n", megabytes(peakRssBytes()));
-    std::printf("| %.0f mm | %zu | %zu | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.1f / %.1f | %.0f / %.0f | %.0f |\n",
-                args.heightMm, object.activeVoxelCount(), interior.activeVoxelCount(), readSeconds, readCpu,
-                objectSeconds, objectCpu, interiorSeconds, interiorCpu, writeSeconds + shellSeconds, writeCpu + shellCpu,
-                meshSeconds, meshCpu, pipelineSeconds, pipelineCpu, distanceNs, closestNs, megabytes(peakRssBytes()));
+    std::printf(
+        "| %.0f mm | %zu | %zu | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.1f "
+        "/ %.1f | %.0f / %.0f | %.0f |\n",
+        args.heightMm, object.activeVoxelCount(), interior.activeVoxelCount(), readSeconds, readCpu,
+        objectSeconds, objectCpu, interiorSeconds, interiorCpu, writeSeconds + shellSeconds,
+        writeCpu + shellCpu, meshSeconds, meshCpu, pipelineSeconds, pipelineCpu, distanceNs, closestNs,
+        megabytes(peakRssBytes()));
 }
 
 void runAccuracy(const Args& args) {
@@ -202,13 +221,16 @@ void runAccuracy(const Args& args) {
     scale.heightMm = args.heightMm;
     scale.up = args.isYUp ? mesh::UpAxis::Y : mesh::UpAxis::Z;
     const TriMesh input =
-        mesh::scaleToMillimetres(mesh::validateClosedMesh(readMesh(args.mesh), {}, args.mesh, context), scale).mesh;
+        mesh::scaleToMillimetres(mesh::validateClosedMesh(readMesh(args.mesh), {}, args.mesh, context), scale)
+            .mesh;
     const test::MeshDistance toInput(input);
     const std::vector<Vec3d> inputSamples = test::sampleSurface(input, 20000, 1);
 
-    std::printf("round trip mesh -> level set -> mesh, %s at %.0f mm (20000 samples each way)\n", args.mesh.c_str(),
-                args.heightMm);
-    std::printf("| voxel mm | seconds | triangles | Hausdorff 95%% mm | 99%% mm | max mm |\n|---|---:|---:|---:|---:|---:|\n");
+    std::printf("round trip mesh -> level set -> mesh, %s at %.0f mm (20000 samples each way)\n",
+                args.mesh.c_str(), args.heightMm);
+    std::printf(
+        "| voxel mm | seconds | triangles | Hausdorff 95%% mm | 99%% mm | max mm "
+        "|\n|---|---:|---:|---:|---:|---:|\n");
     for (double voxel : {0.5, 1.0, 1.5, 2.0, 3.0}) {
         if (args.isFieldOnly) break;
         Stopwatch clock;
@@ -226,7 +248,9 @@ void runAccuracy(const Args& args) {
     }
 
     std::printf("\ninterior field vs exact distance to the input triangles (20000 inside points)\n");
-    std::printf("| field voxel mm | build s | MB | depth err 95%% mm | 99.9%% mm | max mm (at depth) | δ(p) off surface 95%% mm | ||p−δ(p)|| − depth 95%% mm |\n");
+    std::printf(
+        "| field voxel mm | build s | MB | depth err 95%% mm | 99.9%% mm | max mm (at depth) | δ(p) off "
+        "surface 95%% mm | ||p−δ(p)|| − depth 95%% mm |\n");
     std::printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
     for (double voxel : {1.0, 2.0, 3.0}) {
         Stopwatch clock;
@@ -234,7 +258,8 @@ void runAccuracy(const Args& args) {
         options.voxelMm = voxel;
         options.interiorBandMm = std::numeric_limits<double>::infinity();
         options.exteriorBandMm = 10.0;
-        const sdf::InteriorField field = sdf::makeInteriorField(sdf::meshToLevelSet(input, options, context), context);
+        const sdf::InteriorField field =
+            sdf::makeInteriorField(sdf::meshToLevelSet(input, options, context), context);
         const double seconds = clock.seconds();
         std::vector<double> depthErrors, offSurface, lengthErrors;
         double worst = -1, worstDepth = 0;
@@ -264,8 +289,10 @@ void runAccuracy(const Args& args) {
 int main(int argc, char** argv) {
     try {
         const Args args = parse(argc, argv);
-        if (args.isAccuracy) runAccuracy(args);
-        else runSteps(args);
+        if (args.isAccuracy)
+            runAccuracy(args);
+        else
+            runSteps(args);
         return 0;
     } catch (const Error& e) {
         std::fprintf(stderr, "bench_sdf: error: %s\n", e.what());

@@ -19,20 +19,26 @@ int main(int argc, char** argv) {
     auto& app = tool.app();
     app.add_option("grid", input, ".vdb from zf-sdf or zf-shell; - reads stdin")->required();
     app.add_option("-o,--output", output, "Output mesh (.stl .obj .ply); - writes stdout")->required();
-    app.add_option("--grid", gridName, "Which level set to mesh (default: \"shell\" if present, else the first)");
+    app.add_option("--grid", gridName,
+                   "Which level set to mesh (default: \"shell\" if present, else the first)");
     app.add_option("--adaptivity", options.adaptivity, "0 = uniform triangles; up to 1 merges flat regions")
         ->capture_default_str();
     app.add_option("--iso-mm", options.isoMm, "Extract {φ = iso} instead of the surface (negative = inside)")
         ->capture_default_str();
-    tool.addFormatOption("--out-format", outFormat, {"stl", "obj", "ply"}, "Output format (default for -: stl)");
+    tool.addFormatOption("--out-format", outFormat, {"stl", "obj", "ply"},
+                         "Output format (default for -: stl)");
 
     return tool.run(argc, argv, [&](json& report) {
         sdf::checkMeshingOptions(options);  // bad options fail before any input is read
         MeshWriteOptions writeOptions;
-        if (!outFormat.empty()) writeOptions.format = meshFormatFromName(outFormat);
-        else if (output == "-") writeOptions.format = MeshFormat::Stl;
-        else if (fileExtension(output) != "stl" && fileExtension(output) != "obj" && fileExtension(output) != "ply")
-            throw Error(ErrorCode::Usage, "cannot tell the mesh format from '" + output + "': use .stl, .obj, .ply or --out-format");
+        if (!outFormat.empty())
+            writeOptions.format = meshFormatFromName(outFormat);
+        else if (output == "-")
+            writeOptions.format = MeshFormat::Stl;
+        else if (fileExtension(output) != "stl" && fileExtension(output) != "obj" &&
+                 fileExtension(output) != "ply")
+            throw Error(ErrorCode::Usage, "cannot tell the mesh format from '" + output +
+                                              "': use .stl, .obj, .ply or --out-format");
         RunContext& context = tool.context();
         Stopwatch clock;
         const std::vector<sdf::LevelSet> grids = sdf::parseVdb(readInputBytes(input), input, context);
@@ -55,8 +61,9 @@ int main(int argc, char** argv) {
         report["seconds"] = {{"read", readSeconds}, {"mesh", meshSeconds}, {"total", clock.seconds()}};
         report["peak_rss_bytes"] = peakRssBytes();
         char line[160];
-        std::snprintf(line, sizeof(line), "'%s': %zu triangles, %zu vertices; %.1f s", levelSet.info().name.c_str(),
-                      mesh.triangleCount(), mesh.vertexCount(), clock.seconds());
+        std::snprintf(line, sizeof(line), "'%s': %zu triangles, %zu vertices; %.1f s",
+                      levelSet.info().name.c_str(), mesh.triangleCount(), mesh.vertexCount(),
+                      clock.seconds());
         cli::printInfo(tool, line);
         return 0;
     });

@@ -124,7 +124,9 @@ int main(int argc, char** argv) {
             r = partition::partitionSurface(mesh, frame, labels, opt, tool.context());
         } catch (const Error& e) {
             // Input problems here are the frame's, or the pair's: name the frame file (and the mesh).
-            if (e.code() == ErrorCode::InvalidInput) throw Error(e.code(), e.message() + " (mesh " + meshPath + ")", framePath);
+            if (e.code() != ErrorCode::InvalidInput) throw;
+            const bool isPair = e.message().rfind("frame and mesh", 0) == 0;
+            throw Error(e.code(), e.message() + (isPair ? " (mesh " + meshPath + ")" : std::string()), framePath);
             throw;
         }
         partition::PartitionJsonInfo info{meshPath, framePath, transformMm, mesh.positions.size()};

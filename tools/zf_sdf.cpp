@@ -18,24 +18,29 @@ using namespace zomefab;
 using nlohmann::json;
 
 int main(int argc, char** argv) {
-    cli::Tool tool("zf-sdf", "Turn a closed mesh into signed distance level sets (OpenVDB .vdb, millimetres).");
+    cli::Tool tool("zf-sdf",
+                   "Turn a closed mesh into signed distance level sets (OpenVDB .vdb, millimetres).");
     std::string input, output, inFormat, up = "z";
     mesh::ScaleOptions scaleOptions;
     sdf::ObjectFieldOptions options;
     auto& app = tool.app();
     app.add_option("mesh", input, "Closed mesh (.stl .obj .ply .gltf .glb); - reads stdin")->required();
     app.add_option("-o,--output", output, "Output .vdb; - writes stdout")->required();
-    auto* height = app.add_option("--height-mm", scaleOptions.heightMm, "Scale uniformly to this height along the up axis");
-    app.add_option("--scale", scaleOptions.scale, "Alternative: multiply file units by this to get mm")->excludes(height);
+    auto* height = app.add_option("--height-mm", scaleOptions.heightMm,
+                                  "Scale uniformly to this height along the up axis");
+    app.add_option("--scale", scaleOptions.scale, "Alternative: multiply file units by this to get mm")
+        ->excludes(height);
     app.add_option("--up", up, "The input's up axis; y-up meshes are rotated to z up")
         ->check(CLI::IsMember({"z", "y"}, CLI::ignore_case))
         ->default_val("z");
-    tool.addFormatOption("--in-format", inFormat, {"stl", "obj", "ply", "gltf", "glb"}, "Input format (needed for -)");
+    tool.addFormatOption("--in-format", inFormat, {"stl", "obj", "ply", "gltf", "glb"},
+                         "Input format (needed for -)");
     app.add_option("--voxel-mm", options.voxelMm, "Voxel size of the object grid")->capture_default_str();
     app.add_option("--shell-depth-mm", options.shellDepthMm,
                    "Exact distances this deep inside: the thickest shell zf-shell can cut")
         ->capture_default_str();
-    app.add_option("--field-voxel-mm", options.fieldVoxelMm, "Voxel size of the interior grid (frame optimisation)")
+    app.add_option("--field-voxel-mm", options.fieldVoxelMm,
+                   "Voxel size of the interior grid (frame optimisation)")
         ->capture_default_str();
 
     return tool.run(argc, argv, [&](json& report) {
@@ -63,7 +68,9 @@ int main(int argc, char** argv) {
             levelSet->info().generator = generatorString();
             levelSet->info().transformMm = scaled.transformMm;
         }
-        writeOutputAtomic(output, [&](std::ostream& out) { sdf::writeVdb({field.object, field.interior}, out); });
+        writeOutputAtomic(output, [&](std::ostream& out) {
+            sdf::writeVdb({field.object, field.interior}, out);
+        });
         const double totalSeconds = clock.seconds();
 
         report["input"] = input;
@@ -77,10 +84,11 @@ int main(int argc, char** argv) {
         report["seconds"] = {{"read", readSeconds}, {"level_sets", fieldSeconds}, {"total", totalSeconds}};
         report["peak_rss_bytes"] = peakRssBytes();
         char line[256];
-        std::snprintf(line, sizeof(line), "%.1f x %.1f x %.1f mm; object %zu voxels (%g mm), interior %zu voxels (%g mm); %.1f s",
+        std::snprintf(line, sizeof(line),
+                      "%.1f x %.1f x %.1f mm; object %zu voxels (%g mm), interior %zu voxels (%g mm); %.1f s",
                       scaled.sizeMm[0], scaled.sizeMm[1], scaled.sizeMm[2], field.object.activeVoxelCount(),
-                      field.object.info().voxelMm, field.interior.activeVoxelCount(), field.interior.info().voxelMm,
-                      totalSeconds);
+                      field.object.info().voxelMm, field.interior.activeVoxelCount(),
+                      field.interior.info().voxelMm, totalSeconds);
         cli::printInfo(tool, line);
         return 0;
     });

@@ -18,7 +18,8 @@ int main(int argc, char** argv) {
     sdf::ShellOptions options;
     auto& app = tool.app();
     app.add_option("object", input, "OBJECT.vdb from zf-sdf; - reads stdin")->required();
-    app.add_option("-o,--output", output, "Output .vdb with one grid, \"shell\"; - writes stdout")->required();
+    app.add_option("-o,--output", output, "Output .vdb with one grid, \"shell\"; - writes stdout")
+        ->required();
     app.add_option("--shell-mm", options.shellMm, "Wall thickness, at least 1 mm (paper: dMin = 16 mm)")
         ->capture_default_str();
     app.add_option("--grid", gridName, "Which level set of the input to hollow")->capture_default_str();

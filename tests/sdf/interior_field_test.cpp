@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include "zomefab/sdf/interior_field.h"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -8,13 +10,12 @@
 #include "mesh_distance.h"
 #include "test_util.h"
 #include "zomefab/core/error.h"
-#include "zomefab/sdf/interior_field.h"
 
 using namespace zomefab;
 using namespace zomefab::sdf;
 
 TEST_CASE("forbidden zone: the paper's plateaus and a quadratic from 0 at dMin to fMax at dMax") {
-    const ForbiddenZoneOptions o;  // dMin 16, dMax 47.3, fThick 90, fMax 70
+    const ForbiddenZoneOptions o;           // dMin 16, dMax 47.3, fThick 90, fMax 70
     CHECK(forbiddenZone(-5.0, o) == 90.0);  // outside the object
     CHECK(forbiddenZone(0.0, o) == 90.0);
     CHECK(forbiddenZone(15.999, o) == 90.0);
@@ -42,8 +43,8 @@ TEST_CASE("interior field: a sphere's depth, inside test and closest points matc
     levelSet.interiorBandMm = std::numeric_limits<double>::infinity();
     levelSet.exteriorBandMm = options.fieldExteriorMm;
     levelSet.name = "interior";
-    const InteriorField field = makeInteriorField(meshToLevelSet(sphere, levelSet, RunContext::silent()),
-                                                  RunContext::silent());
+    const InteriorField field =
+        makeInteriorField(meshToLevelSet(sphere, levelSet, RunContext::silent()), RunContext::silent());
     CHECK(field.voxelMm() == 2.0);
     CHECK(std::isinf(field.interiorBandMm()));
     const Box3d box = field.boundsMm();
@@ -68,14 +69,20 @@ TEST_CASE("interior field: a sphere's depth, inside test and closest points matc
         const Vec3d e{q[0] - exact[0], q[1] - exact[1], q[2] - exact[2]};
         const Vec3d fromCentre{q[0] - c[0], q[1] - c[1], q[2] - c[2]};
         // δ(p) is on the surface everywhere...
-        worstOffSurface = std::max(worstOffSurface, std::abs(std::sqrt(fromCentre[0] * fromCentre[0] + fromCentre[1] * fromCentre[1] + fromCentre[2] * fromCentre[2]) - r));
+        worstOffSurface =
+            std::max(worstOffSurface,
+                     std::abs(std::sqrt(fromCentre[0] * fromCentre[0] + fromCentre[1] * fromCentre[1] +
+                                        fromCentre[2] * fromCentre[2]) -
+                              r));
         // ...and the right surface point away from the centre, where every surface point is nearly
         // as close (the medial singularity; the 2 mm field's values decide there).
-        if (radius >= 20.0) worstClosest = std::max(worstClosest, std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]));
+        if (radius >= 20.0)
+            worstClosest = std::max(worstClosest, std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]));
         ++checked;
     }
     MESSAGE("sphere, 2 mm field: worst depth error " << worstDepth << " mm, closest point " << worstClosest
-                                                     << " mm (depth <= 40 mm), off the surface " << worstOffSurface << " mm");
+                                                     << " mm (depth <= 40 mm), off the surface "
+                                                     << worstOffSurface << " mm");
     CHECK(worstDepth < 0.25);
     CHECK(worstClosest < 1.0);
     CHECK(worstOffSurface < 0.25);
@@ -84,6 +91,11 @@ TEST_CASE("interior field: a sphere's depth, inside test and closest points matc
     // Far outside the box the distance keeps growing with the distance to the box.
     const double far = field.signedDistanceMm({c[0] + r + 200, c[1], c[2]});
     CHECK(far > 150);
+    // ... and its nearest surface point is the one nearest to the box (the border cells' path).
+    const Vec3d farFoot = field.closestSurfacePointMm({c[0] + r + 200, c[1] + 0.3, c[2] - 0.2});
+    CHECK(std::abs(farFoot[0] - (c[0] + r)) < 0.3);
+    CHECK(std::abs(farFoot[1] - c[1]) < 0.5);
+    CHECK(std::abs(farFoot[2] - c[2]) < 0.5);
 }
 
 TEST_CASE("interior field: a box's depths match the exact mesh distance") {
@@ -93,8 +105,8 @@ TEST_CASE("interior field: a box's depths match the exact mesh distance") {
     levelSet.voxelMm = 2.0;
     levelSet.interiorBandMm = std::numeric_limits<double>::infinity();
     levelSet.exteriorBandMm = 10.0;
-    const InteriorField field = makeInteriorField(meshToLevelSet(box, levelSet, RunContext::silent()),
-                                                  RunContext::silent());
+    const InteriorField field =
+        makeInteriorField(meshToLevelSet(box, levelSet, RunContext::silent()), RunContext::silent());
     const test::MeshDistance exact(box);
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> x(1, 119), y(1, 79), z(1, 59);
@@ -103,7 +115,8 @@ TEST_CASE("interior field: a box's depths match the exact mesh distance") {
         const Vec3d p{x(rng), y(rng), z(rng)};
         errors.push_back(std::abs(field.depthMm(p) - exact.distance(p)));
     }
-    MESSAGE("box, 2 mm field: depth error 95% " << test::quantile(errors, 0.95) << " max " << test::quantile(errors, 1.0));
+    MESSAGE("box, 2 mm field: depth error 95% " << test::quantile(errors, 0.95) << " max "
+                                                << test::quantile(errors, 1.0));
     // Trilinear interpolation is exact for a plane; errors only near the box's medial creases.
     CHECK(test::quantile(errors, 0.95) < 0.1);
     CHECK(test::quantile(errors, 1.0) < 1.0);

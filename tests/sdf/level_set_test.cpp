@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include "zomefab/sdf/level_set.h"
+
 #include <doctest/doctest.h>
 #include <tbb/global_control.h>
 
@@ -11,7 +13,6 @@
 #include "zomefab/core/error.h"
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/mesh/scale.h"
-#include "zomefab/sdf/level_set.h"
 #include "zomefab/sdf/vdb_file.h"
 
 using namespace zomefab;
@@ -32,7 +33,8 @@ ErrorCode codeOf(const std::function<void()>& f) {
 }
 
 double radius(const Vec3f& p, const Vec3d& c) {
-    return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]));
+    return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) +
+                     (p[2] - c[2]) * (p[2] - c[2]));
 }
 
 /// Distance from @p p to the boundary of the box [lo, hi] (unsigned).
@@ -62,8 +64,9 @@ TEST_CASE("level_set: sphere volume within 1% and surface within half a voxel") 
     // φ is the signed distance within the band.
     for (const Vec3d& p : {Vec3d{c[0] + r - 1.5, c[1], c[2]}, Vec3d{c[0], c[1] + r + 2.2, c[2]},
                            Vec3d{c[0] + 0.5, c[1] - 0.3, c[2] - r + 0.7}}) {
-        const double analytic =
-            std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2])) - r;
+        const double analytic = std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) +
+                                          (p[2] - c[2]) * (p[2] - c[2])) -
+                                r;
         CHECK(std::abs(ls.valueMm(p) - analytic) < 0.1);
     }
     const double analyticVolume = 4.0 / 3.0 * kPi * r * r * r;

@@ -51,7 +51,8 @@ MeshDistance::MeshDistance(const TriMesh& mesh, double cellMm) : mMesh(mesh) {
     if (cellMm <= 0) {
         double sum = 0;
         for (const Triangle& t : mesh.triangles) {
-            const V a = toD(mesh.positions[t[0]]), b = toD(mesh.positions[t[1]]), c = toD(mesh.positions[t[2]]);
+            const V a = toD(mesh.positions[t[0]]), b = toD(mesh.positions[t[1]]),
+                    c = toD(mesh.positions[t[2]]);
             sum += std::sqrt(dot(sub(b, a), sub(b, a))) + std::sqrt(dot(sub(c, a), sub(c, a)));
         }
         cellMm = std::max(4.0 * sum / (2.0 * double(std::max<size_t>(1, mesh.triangles.size()))), 1e-6);
@@ -90,13 +91,15 @@ MeshDistance::MeshDistance(const TriMesh& mesh, double cellMm) : mMesh(mesh) {
         cellRange(mesh.triangles[f], lo, hi);
         for (int i = lo[0]; i <= hi[0]; ++i)
             for (int j = lo[1]; j <= hi[1]; ++j)
-                for (int k = lo[2]; k <= hi[2]; ++k) mItems[counts[(size_t(i) * mDims[1] + j) * mDims[2] + k]++] = f;
+                for (int k = lo[2]; k <= hi[2]; ++k)
+                    mItems[counts[(size_t(i) * mDims[1] + j) * mDims[2] + k]++] = f;
     }
 }
 
 double MeshDistance::distance(const Vec3d& p, Vec3d* closest) const {
     int c[3];
-    for (int a = 0; a < 3; ++a) c[a] = std::clamp(int(std::floor((p[a] - mOrigin[a]) / mCell)), 0, mDims[a] - 1);
+    for (int a = 0; a < 3; ++a)
+        c[a] = std::clamp(int(std::floor((p[a] - mOrigin[a]) / mCell)), 0, mDims[a] - 1);
     double best2 = std::numeric_limits<double>::infinity();
     V bestPoint = p;
     const int maxRing = std::max({mDims[0], mDims[1], mDims[2]});
@@ -112,8 +115,8 @@ double MeshDistance::distance(const Vec3d& p, Vec3d* closest) const {
                     const size_t cell = (size_t(i) * mDims[1] + j) * mDims[2] + k;
                     for (uint32_t n = mStart[cell]; n < mStart[cell + 1]; ++n) {
                         const Triangle& t = mMesh.triangles[mItems[n]];
-                        const V q = closestOnTriangle(p, toD(mMesh.positions[t[0]]), toD(mMesh.positions[t[1]]),
-                                                      toD(mMesh.positions[t[2]]));
+                        const V q = closestOnTriangle(p, toD(mMesh.positions[t[0]]),
+                                                      toD(mMesh.positions[t[1]]), toD(mMesh.positions[t[2]]));
                         const double d2 = dot(sub(q, p), sub(q, p));
                         if (d2 < best2) {
                             best2 = d2;
@@ -152,7 +155,8 @@ std::vector<Vec3d> sampleSurface(const TriMesh& mesh, size_t count, uint32_t see
     points.reserve(count);
     for (size_t s = 0; s < count; ++s) {
         const double x = uniform(rng) * total;
-        const size_t f = size_t(std::lower_bound(cumulative.begin(), cumulative.end(), x) - cumulative.begin());
+        const size_t f =
+            size_t(std::lower_bound(cumulative.begin(), cumulative.end(), x) - cumulative.begin());
         const Triangle& t = mesh.triangles[std::min(f, mesh.triangles.size() - 1)];
         double u = uniform(rng), v = uniform(rng);
         if (u + v > 1) {
@@ -202,8 +206,9 @@ EdgeReport edgeReport(const TriMesh& mesh) {
             halfEdges.push_back({(uint64_t(std::min(a, b)) << 32) | std::max(a, b), f, a < b});
         }
     }
-    std::sort(halfEdges.begin(), halfEdges.end(),
-              [](const HalfEdge& x, const HalfEdge& y) { return x.key < y.key || (x.key == y.key && x.face < y.face); });
+    std::sort(halfEdges.begin(), halfEdges.end(), [](const HalfEdge& x, const HalfEdge& y) {
+        return x.key < y.key || (x.key == y.key && x.face < y.face);
+    });
     std::vector<uint32_t> parent(mesh.triangles.size());
     std::iota(parent.begin(), parent.end(), 0u);
     auto find = [&](uint32_t x) {

@@ -42,10 +42,10 @@ double signedVolume(const TriMesh& mesh);
 
 /// Edge topology of a triangle mesh.
 struct EdgeReport {
-    size_t boundaryEdges = 0;      ///< used by one triangle
-    size_t nonManifoldEdges = 0;   ///< used by three or more
-    size_t misorientedEdges = 0;   ///< two-triangle edges traversed the same way by both
-    size_t components = 0;         ///< edge-connected components
+    size_t boundaryEdges = 0;     ///< used by one triangle
+    size_t nonManifoldEdges = 0;  ///< used by three or more
+    size_t misorientedEdges = 0;  ///< two-triangle edges traversed the same way by both
+    size_t components = 0;        ///< edge-connected components
     std::vector<uint32_t> componentOfTriangle;
 };
 EdgeReport edgeReport(const TriMesh& mesh);

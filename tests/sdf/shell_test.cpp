@@ -52,7 +52,8 @@ ShellParts splitShell(const TriMesh& shell) {
     parts.outer = test::extractComponent(shell, parts.edges, outerId);
     parts.inner.positions = shell.positions;
     for (size_t f = 0; f < shell.triangles.size(); ++f)
-        if (parts.edges.componentOfTriangle[f] != outerId) parts.inner.triangles.push_back(shell.triangles[f]);
+        if (parts.edges.componentOfTriangle[f] != outerId)
+            parts.inner.triangles.push_back(shell.triangles[f]);
     return parts;
 }
 
@@ -107,10 +108,12 @@ TEST_CASE("shell: the bunny's wall is shellMm thick and closed") {
     CHECK(parts.edges.boundaryEdges == 0);
     CHECK(parts.edges.misorientedEdges == 0);
     const test::MeshDistance inner(parts.inner);
-    const std::vector<double> thickness = test::distancesTo(inner, test::sampleSurface(parts.outer, 3000, 11));
+    const std::vector<double> thickness =
+        test::distancesTo(inner, test::sampleSurface(parts.outer, 3000, 11));
     const double voxel = shell.info().voxelMm;
     MESSAGE("thickness min " << test::quantile(thickness, 0) << " median " << test::quantile(thickness, 0.5)
-                             << " 90% " << test::quantile(thickness, 0.9) << " max " << test::quantile(thickness, 1));
+                             << " 90% " << test::quantile(thickness, 0.9) << " max "
+                             << test::quantile(thickness, 1));
     // Nowhere thinner than the wall; where the surface is convex or flat (most of it) exactly the
     // wall. Concave creases and parts thinner than two walls are legitimately thicker.
     CHECK(test::quantile(thickness, 0.0) > 10.0 - 0.5 * voxel);
@@ -139,7 +142,8 @@ TEST_CASE("shell: a thin object gives a solid piece where it is thinner than two
     const LevelSet object = meshToLevelSet(slab, options, RunContext::silent());
     ShellOptions shell;
     shell.shellMm = 4.0;
-    const TriMesh mesh = levelSetToMesh(makeShell(object, shell, RunContext::silent()), {}, RunContext::silent());
+    const TriMesh mesh =
+        levelSetToMesh(makeShell(object, shell, RunContext::silent()), {}, RunContext::silent());
     CHECK(test::edgeReport(mesh).components == 1);
     CHECK(std::abs(test::signedVolume(mesh) / (40.0 * 40.0 * 6.0) - 1) < 0.02);
 }
@@ -149,8 +153,10 @@ TEST_CASE("round trip: bunny at 400 mm, two-sided Hausdorff 95th percentile <= 0
     const LevelSet ls = meshToLevelSet(bunny, {}, RunContext::silent());  // default voxel
     const TriMesh back = levelSetToMesh(ls, {}, RunContext::silent());
     const test::MeshDistance toInput(bunny), toOutput(back);
-    const double forward = test::quantile(test::distancesTo(toOutput, test::sampleSurface(bunny, 5000, 1)), 0.95);
-    const double backward = test::quantile(test::distancesTo(toInput, test::sampleSurface(back, 5000, 2)), 0.95);
+    const double forward =
+        test::quantile(test::distancesTo(toOutput, test::sampleSurface(bunny, 5000, 1)), 0.95);
+    const double backward =
+        test::quantile(test::distancesTo(toInput, test::sampleSurface(back, 5000, 2)), 0.95);
     MESSAGE("Hausdorff 95%: input->output " << forward << " mm, output->input " << backward << " mm");
     CHECK(std::max(forward, backward) <= 0.5);
 }

@@ -35,9 +35,11 @@ const std::string kScale = " --height-mm 150 --up y --shell-depth-mm 8 -q";
 
 TEST_CASE("tools: zf-sdf | zf-shell | zf-mesh through pipes gives the closed shell the files give") {
     test::ScratchDir dir("zomefab-sdf-tools");
-    const std::string sdf = test::toolPath("zf-sdf"), shell = test::toolPath("zf-shell"), mesh = test::toolPath("zf-mesh");
+    const std::string sdf = test::toolPath("zf-sdf"), shell = test::toolPath("zf-shell"),
+                      mesh = test::toolPath("zf-mesh");
     const std::string piped = dir.file("piped.stl");
-    REQUIRE(run(sdf + " " + kBunny + kScale + " -o - | " + shell + " - --shell-mm 8 -q -o - | " + mesh + " - -q -o " + piped) == 0);
+    REQUIRE(run(sdf + " " + kBunny + kScale + " -o - | " + shell + " - --shell-mm 8 -q -o - | " + mesh +
+                " - -q -o " + piped) == 0);
     // The same through files.
     REQUIRE(run(sdf + " " + kBunny + kScale + " -o " + dir.file("object.vdb")) == 0);
     REQUIRE(run(shell + " " + dir.file("object.vdb") + " --shell-mm 8 -q -o " + dir.file("shell.vdb")) == 0);

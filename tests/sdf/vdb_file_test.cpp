@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include "zomefab/sdf/vdb_file.h"
+
 #include <doctest/doctest.h>
 #include <openvdb/io/Stream.h>
 #include <openvdb/tools/LevelSetSphere.h>
@@ -10,7 +12,6 @@
 #include "test_util.h"
 #include "zomefab/core/error.h"
 #include "zomefab/sdf/level_set_grid.h"
-#include "zomefab/sdf/vdb_file.h"
 
 using namespace zomefab;
 using namespace zomefab::sdf;
@@ -48,7 +49,8 @@ TEST_CASE("vdb_file: metadata and values survive a round trip, and bytes are det
     coarse.voxelMm = 2.0;
     coarse.interiorBandMm = std::numeric_limits<double>::infinity();
     coarse.name = "interior";
-    const LevelSet interior = meshToLevelSet(test::makeSphere({0, 0, 10}, 12.0), coarse, RunContext::silent());
+    const LevelSet interior =
+        meshToLevelSet(test::makeSphere({0, 0, 10}, 12.0), coarse, RunContext::silent());
 
     const std::string bytes = serializeVdb({object, interior});
     CHECK(bytes == serializeVdb({object, interior}));  // no random UUID
@@ -83,7 +85,8 @@ TEST_CASE("vdb_file: metadata and values survive a round trip, and bytes are det
 TEST_CASE("vdb_file: what is not a millimetre level set is rejected with InvalidInput") {
     CHECK(parseCode("") == ErrorCode::InvalidInput);
     CHECK(parseCode("solid cube\nendsolid cube\n") == ErrorCode::InvalidInput);
-    const std::string good = serializeVdb({meshToLevelSet(test::makeSphere({0, 0, 0}, 5.0), {}, RunContext::silent())});
+    const std::string good =
+        serializeVdb({meshToLevelSet(test::makeSphere({0, 0, 0}, 5.0), {}, RunContext::silent())});
     CHECK(parseCode(good.substr(0, good.size() / 2)) == ErrorCode::InvalidInput);  // truncated
 
     // A fog volume is not a level set.
@@ -94,14 +97,16 @@ TEST_CASE("vdb_file: what is not a millimetre level set is rejected with Invalid
     CHECK(parseCode(foreignVdb(fog)) == ErrorCode::InvalidInput);
 
     // A level set in inches.
-    openvdb::FloatGrid::Ptr inches = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(5.0f, {0, 0, 0}, 0.5f);
+    openvdb::FloatGrid::Ptr inches =
+        openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(5.0f, {0, 0, 0}, 0.5f);
     inches->setName("object");
     inches->insertMeta("units", openvdb::StringMetadata("inch"));
     CHECK(parseCode(foreignVdb(inches)) == ErrorCode::InvalidInput);
 }
 
 TEST_CASE("vdb_file: a foreign level set without metadata is read as millimetres with a warning") {
-    openvdb::FloatGrid::Ptr sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(10.0f, {0, 0, 0}, 0.5f);
+    openvdb::FloatGrid::Ptr sphere =
+        openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(10.0f, {0, 0, 0}, 0.5f);
     sphere->setName("ball");
     RunContext context;
     const std::vector<LevelSet> grids = parseVdb(foreignVdb(sphere), "ball.vdb", context);

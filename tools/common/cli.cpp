@@ -73,7 +73,7 @@ int Tool::run(int argc, char** argv, const std::function<int(nlohmann::json&)>& 
     const std::string toolName = mName;
     auto log = [toolName, verbosity](LogLevel level, const std::string& msg) {
         if (level == LogLevel::Debug && verbosity < 2) return;
-        if (level == LogLevel::Info && verbosity < 0) return;
+        if (level != LogLevel::Debug && verbosity < 0) return;  // -q: errors only
         std::cerr << toolName << ": " << levelPrefix(level) << msg << '\n';
     };
     auto stageClock = std::make_shared<Stopwatch>();

@@ -26,12 +26,28 @@ Vec3d InteriorField::smoothGradient(const Vec3d& p) const {
     // curvature radius r, against O(voxel / r) for the trilinear interpolant's own gradient.
     int i0[3];
     double f[3];
+    bool isInterior = true;  // the cell's neighbours along every axis exist: no clamping needed
     for (int a = 0; a < 3; ++a) {
         const double x = std::min(std::max((p[a] - mOriginMm[a]) * mInvVoxel, 0.0), double(mDims[a] - 1));
         i0[a] = std::min(int(x), mDims[a] - 2);
         f[a] = x - i0[a];
+        isInterior = isInterior && i0[a] >= 1 && i0[a] + 2 <= mDims[a] - 1;
     }
     Vec3d g{0, 0, 0};
+    if (isInterior) {
+        const ptrdiff_t sz = 1, sy = mDims[2], sx = ptrdiff_t(mDims[1]) * mDims[2];
+        const float* base = &mValues[size_t(i0[0]) * size_t(sx) + size_t(i0[1]) * size_t(sy) + size_t(i0[2])];
+        for (int corner = 0; corner < 8; ++corner) {
+            const int a = corner & 1, b = (corner >> 1) & 1, c = (corner >> 2) & 1;
+            const float* v = base + a * sx + b * sy + c * sz;
+            const double w = (a ? f[0] : 1 - f[0]) * (b ? f[1] : 1 - f[1]) * (c ? f[2] : 1 - f[2]);
+            g[0] += w * (double(v[sx]) - double(v[-sx]));
+            g[1] += w * (double(v[sy]) - double(v[-sy]));
+            g[2] += w * (double(v[sz]) - double(v[-sz]));
+        }
+        const double scale = 0.5 * mInvVoxel;
+        return {g[0] * scale, g[1] * scale, g[2] * scale};
+    }
     for (int corner = 0; corner < 8; ++corner) {
         const int c[3] = {i0[0] + (corner & 1), i0[1] + ((corner >> 1) & 1), i0[2] + ((corner >> 2) & 1)};
         double w = 1;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file The interior distance field and the forbidden zone F(p) for the frame optimisation
 /// (paper §4.3.1). Light: no OpenVDB here. The field is a dense float array resampled once from the
-/// "interior" level set, so a query is a few loads and multiplies (~15 ns, docs/benchmarks.md),
+/// "interior" level set, so a query is eight loads and a few multiplies (docs/benchmarks.md),
 /// and, being read-only after construction, it is safe for any number of concurrent readers
 /// (parallel annealing chains).
 #pragma once

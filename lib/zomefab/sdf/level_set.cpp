@@ -106,8 +106,7 @@ bool readMeta(const openvdb::GridBase& grid, const char* key, ValueT& value) {
     return true;
 }
 
-LevelSet levelSetFromGrid(openvdb::FloatGrid::Ptr grid, const std::string& sourceName,
-                          RunContext& context) {
+LevelSet levelSetFromGrid(openvdb::FloatGrid::Ptr grid, const std::string& sourceName, RunContext& context) {
     const std::string gridName = grid->getName().empty() ? "(unnamed)" : grid->getName();
     const openvdb::math::Transform& xform = grid->transform();
     const bool isUniformScale = xform.isLinear() && xform.hasUniformScale() &&
@@ -146,8 +145,7 @@ LevelSet levelSetFromGrid(openvdb::FloatGrid::Ptr grid, const std::string& sourc
     if (readMeta<openvdb::Mat4DMetadata>(*grid, kTransformKey, m)) info.transformMm = fromVdbMatrix(m);
     if (!std::isfinite(info.exteriorBandMm) || info.exteriorBandMm < 0 || std::isnan(info.interiorBandMm) ||
         info.interiorBandMm < 0 || !std::isfinite(info.shellMm) || info.shellMm < 0) {
-        throw Error(ErrorCode::InvalidInput, "grid '" + gridName + "' has invalid band metadata",
-                    sourceName);
+        throw Error(ErrorCode::InvalidInput, "grid '" + gridName + "' has invalid band metadata", sourceName);
     }
     return detail::LevelSetAccess::wrap(std::move(grid), std::move(info));
 }
@@ -252,10 +250,10 @@ void writeVdb(const std::vector<LevelSet>& levelSets, std::ostream& out) {
     if (!out) throw Error(ErrorCode::WriteFailed, "cannot write the .vdb stream");
 }
 
-std::vector<LevelSet> parseVdb(std::string_view bytes, const std::string& sourceName,
-                               RunContext& context) {
+std::vector<LevelSet> parseVdb(std::string_view bytes, const std::string& sourceName, RunContext& context) {
     ensureOpenVdbInitialized();
-    if (bytes.empty()) throw Error(ErrorCode::InvalidInput, "empty input, expected a .vdb stream", sourceName);
+    if (bytes.empty())
+        throw Error(ErrorCode::InvalidInput, "empty input, expected a .vdb stream", sourceName);
     openvdb::GridPtrVecPtr grids;
     try {
         std::istringstream in{std::string(bytes)};
@@ -275,15 +273,16 @@ std::vector<LevelSet> parseVdb(std::string_view bytes, const std::string& source
             if (grid && grid->getGridClass() == openvdb::GRID_LEVEL_SET) {
                 result.push_back(levelSetFromGrid(grid, sourceName, context));
             } else {
-                others += (others.empty() ? "" : ", ") + ("'" + base->getName() + "' (" + base->valueType() +
-                                                          " " + openvdb::GridBase::gridClassToString(base->getGridClass()) +
-                                                          ")");
+                others += (others.empty() ? "" : ", ") +
+                          ("'" + base->getName() + "' (" + base->valueType() + " " +
+                           openvdb::GridBase::gridClassToString(base->getGridClass()) + ")");
             }
         }
     }
     if (result.empty()) {
         throw Error(ErrorCode::InvalidInput,
-                    "no float level-set grid in the .vdb stream" + (others.empty() ? std::string() : "; found " + others),
+                    "no float level-set grid in the .vdb stream" +
+                        (others.empty() ? std::string() : "; found " + others),
                     sourceName);
     }
     return result;

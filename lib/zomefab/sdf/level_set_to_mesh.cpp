@@ -90,8 +90,10 @@ void checkMeshingOptions(const LevelSetToMeshOptions& options) {
     if (!(options.minComponentVolumeMm3 >= 0))
         throw Error(ErrorCode::Usage, "the smallest component volume must be ≥ 0 mm³");
     if (!(options.adaptivity >= 0 && options.adaptivity <= 1))
-        throw Error(ErrorCode::Usage, "adaptivity must be in [0, 1], got " + formatNumber(options.adaptivity));
-    if (!std::isfinite(options.isoMm)) throw Error(ErrorCode::Usage, "the iso-value must be a finite number of mm");
+        throw Error(ErrorCode::Usage,
+                    "adaptivity must be in [0, 1], got " + formatNumber(options.adaptivity));
+    if (!std::isfinite(options.isoMm))
+        throw Error(ErrorCode::Usage, "the iso-value must be a finite number of mm");
 }
 
 TriMesh levelSetToMesh(const LevelSet& levelSet, const LevelSetToMeshOptions& options, RunContext& context) {
@@ -102,8 +104,9 @@ TriMesh levelSetToMesh(const LevelSet& levelSet, const LevelSetToMeshOptions& op
     const double exteriorLimit = levelSet.info().exteriorBandMm + (kHalfWidthVoxels - 1) * voxel;
     const double interiorLimit = levelSet.info().interiorBandMm + (kHalfWidthVoxels - 1) * voxel;
     if (!std::isfinite(options.isoMm) || options.isoMm > exteriorLimit || options.isoMm < -interiorLimit) {
-        throw Error(ErrorCode::Usage, "iso-value " + formatNumber(options.isoMm) + " mm is outside the level set's band [" +
-                                          formatNumber(-interiorLimit) + ", " + formatNumber(exteriorLimit) + "] mm");
+        throw Error(ErrorCode::Usage,
+                    "iso-value " + formatNumber(options.isoMm) + " mm is outside the level set's band [" +
+                        formatNumber(-interiorLimit) + ", " + formatNumber(exteriorLimit) + "] mm");
     }
     if (grid->activeVoxelCount() == 0)
         throw Error(ErrorCode::ProcessingFailed, "the level set '" + levelSet.info().name + "' is empty");
@@ -142,7 +145,8 @@ TriMesh levelSetToMesh(const LevelSet& levelSet, const LevelSetToMeshOptions& op
     }
     context.progress("mesh", 1.0);
     if (mesh.triangles.empty())
-        throw Error(ErrorCode::ProcessingFailed, "the level set '" + levelSet.info().name + "' has no surface");
+        throw Error(ErrorCode::ProcessingFailed,
+                    "the level set '" + levelSet.info().name + "' has no surface");
     return mesh;
 }
 

@@ -40,7 +40,8 @@ std::string formatMm(double value) {
 
 void requirePositive(double value, const char* what) {
     if (!(std::isfinite(value) && value > 0))
-        throw Error(ErrorCode::Usage, std::string(what) + " must be a positive number of mm, got " + formatMm(value));
+        throw Error(ErrorCode::Usage,
+                    std::string(what) + " must be a positive number of mm, got " + formatMm(value));
 }
 
 /// The input checks meshToVolume itself does not do (it would read out of bounds or loop on NaN).
@@ -106,7 +107,8 @@ InsideStats insideStats(const openvdb::FloatGrid& grid) {
 
 LevelSet meshToLevelSet(const TriMesh& mesh, const MeshToLevelSetOptions& options, RunContext& context) {
     requirePositive(options.voxelMm, "the voxel size");
-    if (!(options.interiorBandMm >= 0) || !(options.exteriorBandMm >= 0) || !std::isfinite(options.exteriorBandMm))
+    if (!(options.interiorBandMm >= 0) || !(options.exteriorBandMm >= 0) ||
+        !std::isfinite(options.exteriorBandMm))
         throw Error(ErrorCode::Usage, "band widths must be ≥ 0 mm (the interior one may be infinite)");
     Box3d bounds;
     double areaMm2 = 0;
@@ -118,11 +120,13 @@ LevelSet meshToLevelSet(const TriMesh& mesh, const MeshToLevelSetOptions& option
     // Refuse requests that cannot fit rather than exhaust memory: index coordinates are 32-bit,
     // and a band holds about area / voxel² × band voxels (the whole inside: volume / voxel³).
     const Vec3d size = bounds.size();
-    const double maxExtent = std::max({size[0], size[1], size[2]}) + 2 * (options.exteriorBandMm + halfWidthMm);
-    const double bandVoxels = (options.exteriorBandMm + (isWholeInterior ? 0.0 : options.interiorBandMm)) / voxel +
-                              2.0 * kHalfWidthVoxels;
-    const double estimatedVoxels =
-        areaMm2 / (voxel * voxel) * bandVoxels + (isWholeInterior ? meshVolume / (voxel * voxel * voxel) : 0.0);
+    const double maxExtent =
+        std::max({size[0], size[1], size[2]}) + 2 * (options.exteriorBandMm + halfWidthMm);
+    const double bandVoxels =
+        (options.exteriorBandMm + (isWholeInterior ? 0.0 : options.interiorBandMm)) / voxel +
+        2.0 * kHalfWidthVoxels;
+    const double estimatedVoxels = areaMm2 / (voxel * voxel) * bandVoxels +
+                                   (isWholeInterior ? meshVolume / (voxel * voxel * voxel) : 0.0);
     constexpr double kMaxVoxels = 1.0e9;  // ~4 GB of float values plus the tree
     if (maxExtent / voxel > double(1 << 30) || estimatedVoxels > kMaxVoxels) {
         throw Error(ErrorCode::Usage, "a " + formatMm(voxel) + " mm voxel is too small for a " +
@@ -137,8 +141,8 @@ LevelSet meshToLevelSet(const TriMesh& mesh, const MeshToLevelSetOptions& option
                                                  : float(options.interiorBandMm / voxel + kHalfWidthVoxels);
     VdbInterrupter interrupter(context, "level set '" + options.name + "'");
     const TriMeshAdapter adapter(mesh, voxel);
-    openvdb::FloatGrid::Ptr grid =
-        openvdb::tools::meshToVolume<openvdb::FloatGrid>(interrupter, adapter, *transform, exteriorVoxels, interiorVoxels);
+    openvdb::FloatGrid::Ptr grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+        interrupter, adapter, *transform, exteriorVoxels, interiorVoxels);
     context.throwIfCancelled();
 
     // The sign comes from a flood fill from outside (OpenVDB), so an open or self-intersecting
@@ -147,9 +151,10 @@ LevelSet meshToLevelSet(const TriMesh& mesh, const MeshToLevelSetOptions& option
     const InsideStats stats = insideStats(*grid);
     const double insideVolume = stats.insideVoxels * voxel * voxel * voxel;
     if (stats.insideVoxels == 0) {
-        throw Error(ErrorCode::ProcessingFailed,
-                    "the level set has no inside: the mesh is open, inside out with holes, or thinner than a " +
-                        formatMm(voxel) + " mm voxel everywhere");
+        throw Error(
+            ErrorCode::ProcessingFailed,
+            "the level set has no inside: the mesh is open, inside out with holes, or thinner than a " +
+                formatMm(voxel) + " mm voxel everywhere");
     }
     if (stats.touchesBorder) {
         throw Error(ErrorCode::ProcessingFailed,
@@ -160,8 +165,8 @@ LevelSet meshToLevelSet(const TriMesh& mesh, const MeshToLevelSetOptions& option
     // a leaking fill loses most of it. Half is far outside any discretisation error.
     if (insideVolume < 0.5 * meshVolume) {
         throw Error(ErrorCode::ProcessingFailed,
-                    "the level set's inside (" + formatMm(std::round(insideVolume)) + " mm³) is far smaller than the mesh's volume (" +
-                        formatMm(std::round(meshVolume)) +
+                    "the level set's inside (" + formatMm(std::round(insideVolume)) +
+                        " mm³) is far smaller than the mesh's volume (" + formatMm(std::round(meshVolume)) +
                         " mm³): the mesh is not closed or it self-intersects, so the inside leaked out");
     }
 

@@ -21,10 +21,11 @@ namespace {
 /// A copy of @p source holding ψ = φ + shiftMm as a symmetric narrow band of half width
 /// @p halfWidthMm: active only where |ψ| ≤ halfWidthMm, ± halfWidthMm elsewhere by sign.
 /// Correct wherever φ is exact, i.e. for shiftMm up to the source's interior band.
-openvdb::FloatGrid::Ptr shiftedNarrowBand(const openvdb::FloatGrid& source, float shiftMm, float halfWidthMm) {
+openvdb::FloatGrid::Ptr shiftedNarrowBand(const openvdb::FloatGrid& source, float shiftMm,
+                                          float halfWidthMm) {
     openvdb::FloatGrid::Ptr grid = source.deepCopy();
     openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid->tree());
-    leaves.foreach([&](openvdb::FloatTree::LeafNodeType& leaf, size_t) {
+    leaves.foreach ([&](openvdb::FloatTree::LeafNodeType& leaf, size_t) {
         float* values = leaf.buffer().data();
         for (openvdb::Index i = 0; i < openvdb::FloatTree::LeafNodeType::SIZE; ++i) {
             const float v = values[i] + shiftMm;
@@ -53,18 +54,20 @@ std::string formatMm(double value) {
 
 void checkShellOptions(const ShellOptions& options) {
     if (!(std::isfinite(options.shellMm) && options.shellMm >= 1.0))
-        throw Error(ErrorCode::Usage, "the shell thickness must be at least 1 mm, got " + formatMm(options.shellMm));
+        throw Error(ErrorCode::Usage,
+                    "the shell thickness must be at least 1 mm, got " + formatMm(options.shellMm));
 }
 
 LevelSet makeShell(const LevelSet& object, const ShellOptions& options, RunContext& context) {
     checkShellOptions(options);
     const LevelSetInfo& source = object.info();
     if (options.shellMm > source.interiorBandMm * (1 + 1e-9)) {
-        throw Error(ErrorCode::Usage,
-                    "a " + formatMm(options.shellMm) + " mm shell needs exact distances that deep, but the '" +
-                        source.name + "' grid's interior band reaches " + formatMm(source.interiorBandMm) +
-                        " mm; rebuild it with a deeper band (zf-sdf --shell-depth-mm " + formatMm(options.shellMm) +
-                        ")");
+        throw Error(ErrorCode::Usage, "a " + formatMm(options.shellMm) +
+                                          " mm shell needs exact distances that deep, but the '" +
+                                          source.name + "' grid's interior band reaches " +
+                                          formatMm(source.interiorBandMm) +
+                                          " mm; rebuild it with a deeper band (zf-sdf --shell-depth-mm " +
+                                          formatMm(options.shellMm) + ")");
     }
     const openvdb::FloatGrid::ConstPtr grid = levelSetGrid(object);
     const double voxel = grid->voxelSize()[0];

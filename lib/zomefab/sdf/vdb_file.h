@@ -30,8 +30,7 @@ std::string serializeVdb(const std::vector<LevelSet>& levelSets);
 /// @p context for missing units.
 /// @throw Error(InvalidInput) naming @p sourceName when the bytes are not a .vdb stream, hold no
 ///        float level set, use units other than "mm", or a non-uniform or non-linear transform.
-std::vector<LevelSet> parseVdb(std::string_view bytes, const std::string& sourceName,
-                               RunContext& context);
+std::vector<LevelSet> parseVdb(std::string_view bytes, const std::string& sourceName, RunContext& context);
 
 /// The level set named @p name in @p levelSets; when @p name is empty, the first one.
 /// @throw Error(InvalidInput) naming @p sourceName and listing the grids present.

@@ -1,0 +1,174 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "zomefab/report/cost_report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "zomefab/core/error.h"
+#include "zomefab/report/mesh_clip.h"
+
+namespace zomefab::report {
+
+namespace {
+
+double savedPercent(double zomefab, double baseline) {
+    return baseline > 0.0 ? 100.0 * (1.0 - zomefab / baseline) : 0.0;
+}
+
+std::string fixed(double v, int decimals = 2) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+    return buf;
+}
+
+nlohmann::json printJson(const PrintEstimate& e) {
+    nlohmann::json j = {{"parts", e.parts}, {"hours", e.hours()}, {"filament_mm3", e.filamentMm3}};
+    if (e.partVolumeMm3 > 0.0)
+        j["model"] = {{"part_volume_mm3", e.partVolumeMm3},
+                      {"external_perimeter_mm3", e.externalPerimeterMm3},
+                      {"inner_perimeter_mm3", e.innerPerimeterMm3},
+                      {"solid_layers_mm3", e.solidMm3},
+                      {"infill_mm3", e.infillMm3},
+                      {"layers", e.layers}};
+    return j;
+}
+
+nlohmann::json fabricationJson(const Fabrication& f) {
+    return {{"print", printJson(f.print)},
+            {"filament", {{"length_m", f.filament.lengthM}, {"mass_g", f.filament.massG}, {"cost_usd", f.filament.costUsd}}},
+            {"assembly_hours", f.assemblyHours},
+            {"zometool_usd", f.zomeUsd},
+            {"total_hours", f.totalHours()},
+            {"total_usd", f.totalUsd()}};
+}
+
+}  // namespace
+
+double assemblyHours(const zome::PartsList& parts, const AssemblyTimeOptions& options) {
+    return (double(parts.strutTotal()) * options.secondsPerStrut + double(parts.balls) * options.secondsPerBall) / 3600.0;
+}
+
+const char* estimateSourceName(EstimateSource source) {
+    return source == EstimateSource::PrusaSlicer ? "prusa-slicer" : "estimator";
+}
+
+CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piecesMm, const zome::PartsList& parts,
+                      const CostOptions& options, RunContext& context) {
+    options.print.validate();
+    options.filament.validate();
+    if (!(options.assembly.secondsPerStrut >= 0.0) || !(options.assembly.secondsPerBall >= 0.0))
+        throw Error(ErrorCode::Usage, "assembly seconds per strut and per ball must not be negative");
+    CostReport report;
+    report.options = options;
+    report.source = options.source;
+    report.parts = parts;
+    report.pieceCount = piecesMm.size();
+    report.objectVolumeMm3 = meshVolumeMm3(objectMm);
+    for (const TriMesh& p : piecesMm) report.piecesVolumeMm3 += meshVolumeMm3(p);
+
+    context.progress("report", 0.0);
+    const std::vector<TriMesh> baselineParts = octreeParts(objectMm, options.printerMm, 10, context);
+    report.baselinePartCount = baselineParts.size();
+
+    const double zomeUsd = zome::partsCostUsd(parts, options.prices);
+    const double buildHours = assemblyHours(parts, options.assembly);
+    const size_t total = 2 * (piecesMm.size() + baselineParts.size());
+    size_t done = 0;
+    auto printAll = [&](const std::vector<TriMesh>& meshes, const PrintSettings& settings, const std::string& what) {
+        PrintEstimate sum;
+        for (size_t i = 0; i < meshes.size(); ++i) {
+            context.throwIfCancelled();
+            if (options.source == EstimateSource::PrusaSlicer)
+                sum += sliceWithPrusaSlicer(meshes[i], settings, what + " " + std::to_string(i), options.slicer, context);
+            else
+                sum += estimatePrint(meshes[i], settings, options.rates);
+            context.progress("report", double(++done) / double(total));
+        }
+        return sum;
+    };
+    const std::pair<const char*, double> cases[] = {{"hollow", options.hollowInfillPercent},
+                                                    {"solid", options.solidInfillPercent}};
+    for (const auto& [name, infill] : cases) {
+        PrintSettings settings = options.print;
+        settings.infillPercent = infill;
+        settings.validate();
+        CostCase c;
+        c.name = name;
+        c.infillPercent = infill;
+        c.zomefab.print = printAll(piecesMm, settings, std::string(name) + " piece");
+        c.zomefab.filament = filamentUse(c.zomefab.print.filamentMm3, options.filament);
+        c.zomefab.assemblyHours = buildHours;
+        c.zomefab.zomeUsd = zomeUsd;
+        c.baseline.print = printAll(baselineParts, settings, std::string(name) + " baseline part");
+        c.baseline.filament = filamentUse(c.baseline.print.filamentMm3, options.filament);
+        c.savedTimePercent = savedPercent(c.zomefab.totalHours(), c.baseline.totalHours());
+        c.savedMaterialPercent = savedPercent(c.zomefab.totalUsd(), c.baseline.totalUsd());
+        c.savedFilamentPercent = savedPercent(c.zomefab.print.filamentMm3, c.baseline.print.filamentMm3);
+        report.cases.push_back(std::move(c));
+    }
+    context.progress("report", 1.0);
+    return report;
+}
+
+nlohmann::json costReportToJson(const CostReport& r) {
+    const CostOptions& o = r.options;
+    nlohmann::json cases = nlohmann::json::array();
+    for (const CostCase& c : r.cases)
+        cases.push_back({{"name", c.name},
+                         {"infill_percent", c.infillPercent},
+                         {"zomefab", fabricationJson(c.zomefab)},
+                         {"baseline", fabricationJson(c.baseline)},
+                         {"saved_time_percent", c.savedTimePercent},
+                         {"saved_material_percent", c.savedMaterialPercent},
+                         {"saved_filament_percent", c.savedFilamentPercent}});
+    return {{"source", estimateSourceName(r.source)},
+            {"pieces", r.pieceCount},
+            {"baseline_parts", r.baselinePartCount},
+            {"object_volume_mm3", r.objectVolumeMm3},
+            {"pieces_volume_mm3", r.piecesVolumeMm3},
+            {"zometool", zome::partsListToJson(r.parts, o.prices)},
+            {"cases", std::move(cases)},
+            {"options",
+             {{"printer_mm", o.printerMm},
+              {"layer_height_mm", o.print.layerHeightMm},
+              {"first_layer_height_mm", o.print.firstLayerHeightMm},
+              {"nozzle_mm", o.print.nozzleMm},
+              {"extrusion_width_mm", o.print.extrusionWidthMm},
+              {"perimeters", o.print.perimeters},
+              {"top_layers", o.print.topLayers},
+              {"bottom_layers", o.print.bottomLayers},
+              {"filament_mm", o.filament.diameterMm},
+              {"filament_density_g_per_cm3", o.filament.densityGPerCm3},
+              {"filament_usd_per_m", o.filament.usdPerM},
+              {"assembly_seconds_per_strut", o.assembly.secondsPerStrut},
+              {"assembly_seconds_per_ball", o.assembly.secondsPerBall}}}};
+}
+
+std::string costReportMarkdown(const CostReport& r) {
+    std::string md = "| infill | method | printing (h) | Zometool assembly (h) | overall (h) | printing (USD) | "
+                     "Zometool (USD) | overall (USD) | time saved | material saved |\n"
+                     "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    for (const CostCase& c : r.cases) {
+        const std::string label = c.name + " (" + fixed(c.infillPercent, 0) + "%)";
+        md += "| " + label + " | ZomeFab | " + fixed(c.zomefab.print.hours()) + " | " + fixed(c.zomefab.assemblyHours) +
+              " | " + fixed(c.zomefab.totalHours()) + " | " + fixed(c.zomefab.filament.costUsd) + " | " +
+              fixed(c.zomefab.zomeUsd) + " | " + fixed(c.zomefab.totalUsd()) + " | " + fixed(c.savedTimePercent) +
+              "% | " + fixed(c.savedMaterialPercent) + "% |\n";
+        md += "| | baseline (" + std::to_string(c.baseline.print.parts) + " octree parts) | " +
+              fixed(c.baseline.print.hours()) + " | | " + fixed(c.baseline.totalHours()) + " | " +
+              fixed(c.baseline.filament.costUsd) + " | | " + fixed(c.baseline.totalUsd()) + " | | |\n";
+    }
+    md += "\nFilament (" + fixed(r.options.filament.diameterMm) + " mm, " + fixed(r.options.filament.usdPerM) +
+          " USD/m): ";
+    for (size_t i = 0; i < r.cases.size(); ++i) {
+        const CostCase& c = r.cases[i];
+        md += (i ? "; " : "") + c.name + " ZomeFab " + fixed(c.zomefab.filament.lengthM, 1) + " m / " +
+              fixed(c.zomefab.filament.massG, 0) + " g, baseline " + fixed(c.baseline.filament.lengthM, 1) + " m / " +
+              fixed(c.baseline.filament.massG, 0) + " g (" + fixed(c.savedFilamentPercent, 1) + "% less plastic)";
+    }
+    md += ". Times and filament from the " + std::string(estimateSourceName(r.source)) + ".\n";
+    return md;
+}
+
+}  // namespace zomefab::report

@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file The print estimator's volume model, filament conversions and the octree baseline.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "report_fixtures.h"
+#include "report_test_util.h"
+#include "zomefab/core/error.h"
+#include "zomefab/report/mesh_clip.h"
+#include "zomefab/report/print_estimate.h"
+
+using namespace zomefab;
+using namespace zomefab::report;
+using namespace zomefab::test;
+
+namespace {
+
+PrintSettings withInfill(double percent) {
+    PrintSettings s;
+    s.infillPercent = percent;
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("print_estimate: filament length, mass and cost") {
+    // 1 m of 2.85 mm filament = π·1.425²·1000 mm³ = 6379.4 mm³ (print-estimates.md: ≈ 6.38 cm³, 7.9 g).
+    const double pi = std::acos(-1.0);
+    const FilamentUse one = filamentUse(pi * 1.425 * 1.425 * 1000.0, FilamentOptions{});
+    CHECK(one.lengthM == doctest::Approx(1.0));
+    CHECK(one.massG == doctest::Approx(7.9106).epsilon(1e-4));
+    CHECK(one.costUsd == doctest::Approx(0.56));
+    FilamentOptions thin;
+    thin.diameterMm = 1.75;
+    thin.usdPerM = 0.1;
+    CHECK(filamentUse(pi * 0.875 * 0.875 * 2000.0, thin).lengthM == doctest::Approx(2.0));
+    FilamentOptions bad;
+    bad.diameterMm = 0.0;
+    CHECK_THROWS_AS(bad.validate(), Error);
+}
+
+TEST_CASE("print_estimate: the breakdown of a 20 mm cube follows the documented model exactly") {
+    const PrintEstimate e = estimatePrint(makeBox({0, 0, 0}, {20, 20, 20}), withInfill(20));
+    const double pi = std::acos(-1.0);
+    const double spacing = 0.45 - 0.2 * (1.0 - pi / 4.0);
+    const double wall = 0.45 + 2.0 * spacing;  // 3 perimeters, horizontal thickness
+    CHECK(e.externalPerimeterMm3 + e.innerPerimeterMm3 == doctest::Approx(4 * 400.0 * wall));
+    CHECK(e.externalPerimeterMm3 == doctest::Approx(4 * 400.0 * 0.45));
+    CHECK(e.solidMm3 == doctest::Approx(400.0 * 1.0 + 400.0 * (0.27 + 4 * 0.2)));  // top 5 layers, bottom 5
+    const double interior = 8000.0 - 4 * 400.0 * wall - 400.0 * 2.07;
+    CHECK(e.infillMm3 == doctest::Approx(interior * 0.2 * PrintRates{}.sparseInfillFactor));
+    CHECK(e.filamentMm3 == doctest::Approx(e.externalPerimeterMm3 + e.innerPerimeterMm3 + e.solidMm3 + e.infillMm3));
+    CHECK(e.layers == 100);  // 0.27 + 99 × 0.2 ≥ 20
+    CHECK(e.partVolumeMm3 == doctest::Approx(8000.0));
+    const PrintRates r;
+    CHECK(e.seconds == doctest::Approx(e.externalPerimeterMm3 * r.externalPerimeterSPerMm3 +
+                                       e.innerPerimeterMm3 * r.innerPerimeterSPerMm3 + e.solidMm3 * r.solidSPerMm3 +
+                                       e.infillMm3 * r.sparseInfillSPerMm3 + 100 * r.layerS));
+}
+
+TEST_CASE("print_estimate: solid parts use all their volume; thin walls are all shell") {
+    const TriMesh cube = makeBox({0, 0, 0}, {50, 50, 50});
+    const PrintEstimate solid = estimatePrint(cube, withInfill(100));
+    CHECK(solid.filamentMm3 == doctest::Approx(125000.0));
+    // A 1 mm plate and a hollow cube with 1 mm walls: perimeters and solid layers fill them.
+    for (const TriMesh& thin : {makeBox({0, 0, 0}, {100, 100, 1}), hollowCube(60, 1)}) {
+        const PrintEstimate e = estimatePrint(thin, withInfill(20));
+        CHECK(e.infillMm3 == doctest::Approx(0.0));
+        CHECK(e.filamentMm3 == doctest::Approx(meshVolumeMm3(thin)));
+    }
+}
+
+TEST_CASE("print_estimate: more infill costs more, and moving a part changes nothing") {
+    const TriMesh sphere = makeSphere({0, 0, 30}, 30);
+    double lastSeconds = 0.0, lastMm3 = 0.0;
+    for (double infill : {10.0, 20.0, 50.0, 100.0}) {
+        const PrintEstimate e = estimatePrint(sphere, withInfill(infill));
+        CHECK(e.seconds > lastSeconds);
+        CHECK(e.filamentMm3 > lastMm3);
+        lastSeconds = e.seconds, lastMm3 = e.filamentMm3;
+    }
+    TriMesh moved = sphere;
+    for (Vec3f& p : moved.positions) p[0] += 100.0f, p[1] -= 40.0f, p[2] += 250.0f;
+    const PrintEstimate a = estimatePrint(sphere, withInfill(20)), b = estimatePrint(moved, withInfill(20));
+    CHECK(b.seconds == doctest::Approx(a.seconds).epsilon(1e-5));
+    CHECK(b.filamentMm3 == doctest::Approx(a.filamentMm3).epsilon(1e-5));
+}
+
+TEST_CASE("print_estimate: invalid settings are usage errors") {
+    CHECK_THROWS_AS(estimatePrint(makeBox({0, 0, 0}, {1, 1, 1}), withInfill(0)), Error);
+    CHECK_THROWS_AS(estimatePrint(makeBox({0, 0, 0}, {1, 1, 1}), withInfill(120)), Error);
+    PrintSettings s;
+    s.layerHeightMm = -0.2;
+    CHECK_THROWS_AS(s.validate(), Error);
+}
+
+TEST_CASE("print_estimate: fitsPrinter tries the axis permutations") {
+    CHECK(fitsPrinter({250, 100, 100}, {100, 100, 250}));
+    CHECK(fitsPrinter({200, 200, 200}, {200, 200, 200}));
+    CHECK_FALSE(fitsPrinter({201, 10, 10}, {200, 200, 200}));
+    CHECK_FALSE(fitsPrinter({150, 150, 10}, {100, 200, 200}));
+}
+
+TEST_CASE("print_estimate: the octree baseline cuts until every part fits, and keeps the volume") {
+    SUBCASE("a long box becomes eight octants") {
+        const TriMesh box = makeBox({0, 0, 0}, {300, 100, 100});
+        const std::vector<TriMesh> parts = octreeParts(box, {200, 200, 200});
+        REQUIRE(parts.size() == 8);
+        double volume = 0.0;
+        for (const TriMesh& p : parts) {
+            CHECK(isClosedOriented(p));
+            CHECK(fitsPrinter(boundingBox(p).size(), {200, 200, 200}));
+            volume += meshVolumeMm3(p);
+        }
+        CHECK(volume == doctest::Approx(3e6).epsilon(1e-6));
+    }
+    SUBCASE("a part that fits stays whole") {
+        CHECK(octreeParts(makeBox({0, 0, 0}, {150, 50, 190}), {200, 200, 200}).size() == 1);
+    }
+    SUBCASE("the bunny at 400 mm") {
+        const TriMesh bunny = bunnyMm(400);
+        const std::vector<TriMesh> parts = octreeParts(bunny, {200, 200, 200});
+        CHECK(parts.size() >= 2);
+        double volume = 0.0;
+        for (const TriMesh& p : parts) {
+            CHECK(isClosedOriented(p));
+            CHECK(fitsPrinter(boundingBox(p).size(), {200, 200, 200}));
+            volume += meshVolumeMm3(p);
+        }
+        CHECK(volume == doctest::Approx(meshVolumeMm3(bunny)).epsilon(1e-4));
+    }
+    CHECK_THROWS_AS(octreeParts(makeBox({0, 0, 0}, {10, 10, 10}), {0, 200, 200}), Error);
+}
