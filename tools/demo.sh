@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# `make demo`: the longest pipeline that exists today, on the bundled Stanford bunny at 400 mm.
+# `make demo`: the whole pipeline on the bundled Stanford bunny at 400 mm (README.md).
 set -euo pipefail
 build=${1:-build}
 out=${2:-out/demo}
 mesh=data/bunny_cgal_75k.stl
-mkdir -p "$out"
-"$build/tools/zf-info" "$mesh" --up y --height-mm 400 --report "$out/info.json" > /dev/null
-echo "demo: wrote $out/info.json (mesh checks of $mesh scaled to 400 mm)" >&2
+mkdir -p "$(dirname "$out")"
+"$build/tools/zomefab" run "$mesh" --up y --height-mm 400 -o "$out"
+echo "demo: outputs of $mesh at 400 mm are in $out/ (see README.md for what each file is)" >&2

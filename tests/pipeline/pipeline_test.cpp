@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "test_util.h"
+#include "zomefab/core/error.h"
+#include "zomefab/io/file_io.h"
+#include "zomefab/io/mesh_io.h"
+#include "zomefab/pipeline/pipeline.h"
+#include "zomefab/zome/parts.h"
+#include "zomefab/zome/structure_json.h"
+
+using namespace zomefab;
+namespace fs = std::filesystem;
+
+namespace {
+
+pipeline::RunOptions smallRunOptions() {
+    pipeline::RunOptions o;
+    o.scale.heightMm = 250;
+    o.scale.up = mesh::UpAxis::Y;
+    o.field.voxelMm = 2.0;
+    o.frame.anneal.maxIterations = 20000;
+    o.frame.chains = 2;
+    o.frame.seed = 7;
+    return o;
+}
+
+}  // namespace
+
+TEST_CASE("pipeline: the small bunny end to end, outputs consistent with each other") {
+    const TriMesh mesh = readMesh(test::dataPath("bunny_npm_3674.stl"));
+    const pipeline::RunOptions options = smallRunOptions();
+    const pipeline::RunResult result = pipeline::runPipeline(mesh, "bunny", options, RunContext::silent());
+    CHECK(result.scaled.sizeMm[2] == doctest::Approx(250).epsilon(1e-4));
+    REQUIRE(result.frame.structure.ballCount() > 0);
+    CHECK(!result.partition.pieces.empty());
+
+    test::ScratchDir dir;
+    const std::string out = dir.file("run");
+    const nlohmann::json report = pipeline::runReportJson(result, options, RunContext::silent());
+    const auto files = pipeline::writeRunOutputs(result, options, report, out);
+    for (const std::string& f : files) CHECK(fs::exists(fs::path(out) / f));
+    // The frame file reads back to the same parts list the report states.
+    const zome::Structure back = zome::structureFromJsonText(readInputBytes(out + "/frame.json"));
+    const zome::PartsList parts = zome::partsList(back);
+    CHECK(parts.balls == report["frame"]["balls"].get<size_t>());
+    CHECK(parts.strutTotal() == report["frame"]["struts"].get<size_t>());
+    // No staging directory is left next to the output.
+    for (const auto& entry : fs::directory_iterator(dir.path()))
+        CHECK(entry.path().filename().string().find(".tmp") == std::string::npos);
+}
+
+TEST_CASE("pipeline: same seed gives byte-identical frame and partition files") {
+    const TriMesh mesh = readMesh(test::dataPath("bunny_npm_3674.stl"));
+    const pipeline::RunOptions options = smallRunOptions();
+    test::ScratchDir dir;
+    std::string frames[2], partitions[2];
+    for (int i = 0; i < 2; ++i) {
+        const pipeline::RunResult r = pipeline::runPipeline(mesh, "bunny", options, RunContext::silent());
+        const std::string out = dir.file("run" + std::to_string(i));
+        pipeline::writeRunOutputs(r, options, pipeline::runReportJson(r, options, RunContext::silent()), out);
+        frames[i] = readInputBytes(out + "/frame.json");
+        partitions[i] = readInputBytes(out + "/partition.json");
+    }
+    CHECK(frames[0] == frames[1]);
+    CHECK(partitions[0] == partitions[1]);
+}
+
+TEST_CASE("staged directory: refuses to replace a directory that is not a zomefab output") {
+    test::ScratchDir dir;
+    const std::string target = dir.file("precious");
+    fs::create_directories(target);
+    test::writeBytes(target + "/thesis.tex", "do not delete");
+    {
+        StagedDirectory staged(target, "report.json");
+        test::writeBytes(staged.file("report.json"), "{}");
+        CHECK_THROWS_AS(staged.commit(), Error);
+    }
+    CHECK(fs::exists(target + "/thesis.tex"));
+    CHECK(!fs::exists(target + "/report.json"));
+    // An earlier output (with the marker) is replaced; nothing else is left behind.
+    const std::string previous = dir.file("previous");
+    fs::create_directories(previous);
+    test::writeBytes(previous + "/report.json", "old");
+    test::writeBytes(previous + "/stale.stl", "old");
+    {
+        StagedDirectory staged(previous, "report.json");
+        test::writeBytes(staged.file("report.json"), "new");
+        staged.commit();
+    }
+    CHECK(readInputBytes(previous + "/report.json") == "new");
+    CHECK(!fs::exists(previous + "/stale.stl"));
+    size_t entries = 0;
+    for (const auto& e : fs::directory_iterator(dir.path())) entries += e.is_directory() ? 1 : 0;
+    CHECK(entries == 2);
+}
