@@ -8,8 +8,10 @@ DEMO_DIR  ?= out/demo
 # Libraries the build needs.
 BUILD_PACKAGES := cmake g++ make libopenvdb-dev libtbb-dev libeigen3-dev libdraco-dev libtinygltf-dev \
                   libstb-dev libboost-iostreams-dev doctest-dev libmaxflow-dev liblinear-dev libcli11-dev nlohmann-json3-dev
-# Real checkers the tests run on the outputs: admesh (STL manifold check), draco_decoder.
-TEST_PACKAGES  := admesh draco
+# Real checkers the tests run on the outputs: admesh (STL manifold check), draco_decoder, prusa-slicer.
+TEST_PACKAGES  := admesh draco prusa-slicer
+# The Khronos glTF-Validator (npm), installed once into $(BUILD_DIR)/node; the GLB tests run it with node.
+GLTF_VALIDATOR := gltf-validator@2.0.0-dev.3.10
 
 .PHONY: all build test demo deps test-deps clean fuzz
 
@@ -20,6 +22,8 @@ deps:
 
 test-deps:
 	@./tools/install-deps.sh $(BUILD_PACKAGES) $(TEST_PACKAGES)
+	@if command -v npm > /dev/null && [ ! -f $(BUILD_DIR)/node/node_modules/gltf-validator/package.json ]; then \
+	  npm install --prefix $(BUILD_DIR)/node --no-save --no-audit --no-fund $(GLTF_VALIDATOR); fi
 
 $(BUILD_DIR)/CMakeCache.txt:
 	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release

@@ -2,17 +2,20 @@
 /// @file Benchmark of the surface partition (paper §5): the bunny's 75k-face surface at 400 mm and
 /// the same bunny subdivided to 1.2 million faces, on a B0 cube-lattice frame built in code (the
 /// frame stage's stand-in, tests/partition/partition_fixtures.h). Prints faces × labels, timings
-/// and piece counts; `compare` also runs the 1.2M-face surface without clustering and measures how
-/// far the seams move (docs/benchmarks.md, "Partition").
+/// and piece counts; `compare` / `compare-million` also run with other graph sizes
+/// (--compare-graph-nodes / --compare-refine-nodes; 0 = one level / faces) and measure how far the
+/// seams move (docs/benchmarks.md, "Partition").
 ///
-///   bench_partition [bunny|million|compare|all] [--threads N] [--k K] [--svm-cost C] [--svm-eps E]
-///                   [--svm-max-samples N] [--graph-nodes N]
+///   bench_partition [bunny|million|compare|compare-million|all] [--compare-graph-nodes G]
+///                   [--compare-refine-nodes R] [--compare-w-smoothness W] [--threads N] [--k K] [--svm-cost C] [--svm-eps E]
+///                   [--svm-max-samples N] [--graph-nodes N] [--refine-nodes N]
 #include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <map>
 #include <memory>
 #include <string>
@@ -30,22 +33,29 @@ namespace {
 
 std::string dataFile(const char* name) { return std::string(ZOMEFAB_DATA_DIR) + "/" + name; }
 
+/// Process CPU time (all threads), seconds.
+double cpuSeconds() { return double(std::clock()) / CLOCKS_PER_SEC; }
+
 void report(const char* title, const TriMesh& mesh, const std::vector<zome::BallId>& labels, const PartitionResult& r,
-            double seconds) {
+            double seconds, double cpu) {
     std::printf("%s\n", title);
     std::printf("  faces %zu, labels %zu (outermost balls), k-nearest candidates: %zu graph nodes x labels = %zu pairs\n",
                 mesh.triangles.size(), labels.size(), r.graphNodes, r.candidatePairs);
-    for (const ScheduleStep& s : r.schedule)
+    for (const ScheduleStep& s : r.schedule) {
         std::printf("  w_smoothness %-8g E %.6g -> %.6g  partitions %zu  oversized %zu  sweeps %d  expansions %d  %.2f s\n",
                     s.smoothnessWeight, s.energyNearest, s.energyGraphCut, s.partitions, s.oversized, s.sweeps,
                     s.expansions, s.seconds);
+        if (s.bandNodes > 0)
+            std::printf("    clusters: E %.6g after %d sweeps, %d expansions; refinement band %zu of %zu nodes\n",
+                        s.energyClusters, s.clusterSweeps, s.clusterExpansions, s.bandNodes, r.refineNodes);
+    }
     std::printf("  partitions: nearest ball %zu, graph cut %zu; cells %zu, pieces %zu (splits %zu, merges %zu)\n",
                 r.nearestPartitions, r.graphCutPartitions, r.cells.cellCount(), r.pieces.size(), r.splits, r.merges);
     double worst = 0.0;
     for (const Piece& p : r.pieces) worst = std::max(worst, p.fit.ratio);
     std::printf("  svm samples %zu, agreement %.4f; largest piece fit ratio %.3f\n", r.svmSamples, r.svmAgreement, worst);
-    std::printf("  seconds: graph cut + fit schedule %.2f, svm + pieces %.2f, partitionSurface %.2f, wall %.2f\n",
-                r.secondsGraphCut, r.secondsSvm, r.secondsTotal, seconds);
+    std::printf("  seconds: graph cut + fit schedule %.2f, svm + pieces %.2f, partitionSurface %.2f wall, %.2f CPU\n",
+                r.secondsGraphCut, r.secondsSvm, seconds, cpu);
 }
 
 /// Seam faces: faces with a neighbour in another piece.
@@ -99,6 +109,8 @@ int main(int argc, char** argv) {
     std::string mode = "all";
     int threads = 0;
     PartitionOptions o;
+    size_t compareGraphNodes = 0, compareRefineNodes = 0;
+    double compareSmoothness = 0.0;
     for (int i = 1; i < argc; ++i) {
         auto is = [&](const char* flag) { return std::strcmp(argv[i], flag) == 0 && i + 1 < argc; };
         if (is("--threads"))
@@ -111,6 +123,14 @@ int main(int argc, char** argv) {
             o.svm.tolerance = std::atof(argv[++i]);
         else if (is("--svm-max-samples"))
             o.svmMaxSamples = size_t(std::atol(argv[++i]));
+        else if (is("--compare-graph-nodes"))
+            compareGraphNodes = size_t(std::atol(argv[++i]));
+        else if (is("--compare-w-smoothness"))
+            compareSmoothness = std::atof(argv[++i]);
+        else if (is("--compare-refine-nodes"))
+            compareRefineNodes = size_t(std::atol(argv[++i]));
+        else if (is("--refine-nodes"))
+            o.refineNodeTarget = size_t(std::atol(argv[++i]));
         else if (is("--graph-nodes"))
             o.graphNodeTarget = size_t(std::atol(argv[++i]));
         else
@@ -123,32 +143,54 @@ int main(int argc, char** argv) {
     const test::LatticeFrame frame = test::makeLatticeFrame(bunny.mesh, 12.0);
     std::printf("frame: %zu balls, %zu outermost (B0 cube lattice, balls >= 12 mm inside the surface)\n",
                 frame.structure.ballCount(), frame.outermost.size());
+    auto compare = [&](const char* what, const TriMesh& mesh) {
+        // The default run against one with other graph sizes or another first w_smoothness.
+        double cpu = cpuSeconds();
+        const Stopwatch w;
+        const PartitionResult r = partitionSurface(mesh, frame.structure, frame.outermost, o, RunContext::silent());
+        report(what, mesh, frame.outermost, r, w.seconds(), cpuSeconds() - cpu);
+        PartitionOptions fine = o;
+        fine.graphNodeTarget = compareGraphNodes;
+        fine.refineNodeTarget = compareRefineNodes;
+        if (compareSmoothness > 0) fine.smoothnessStart = compareSmoothness;
+        cpu = cpuSeconds();
+        const Stopwatch w2;
+        const PartitionResult rf = partitionSurface(mesh, frame.structure, frame.outermost, fine, RunContext::silent());
+        std::printf("comparison run: graph nodes %zu, refinement nodes %zu (0 = faces / one level), w_smoothness %g\n",
+                    fine.graphNodeTarget, fine.refineNodeTarget, fine.smoothnessStart);
+        report("same, comparison run",
+               mesh, frame.outermost, rf, w2.seconds(), cpuSeconds() - cpu);
+        const FaceGraph g = buildFaceGraph(mesh);
+        size_t differLabels = 0, differCells = 0;
+        for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+            differLabels += r.graphCutLabels[f] != rf.graphCutLabels[f] ? 1 : 0;
+            differCells += r.cellBalls[r.faceCells[f]] != rf.cellBalls[rf.faceCells[f]] ? 1 : 0;
+        }
+        const auto sa = seamFaces(g, r.facePieces), sb = seamFaces(g, rf.facePieces);
+        const auto [mean1, max1] = seamDistance(g, sa, sb);
+        const auto [mean2, max2] = seamDistance(g, sb, sa);
+        std::printf("default vs finer: graph-cut labels differ on %.2f%% of faces, final cell balls on %.2f%%; "
+                    "final seams: default -> finer mean %.2f mm max %.2f mm, finer -> default mean %.2f mm max %.2f mm\n",
+                    100.0 * double(differLabels) / double(mesh.triangles.size()),
+                    100.0 * double(differCells) / double(mesh.triangles.size()), mean1, max1, mean2, max2);
+    };
     if (mode == "bunny" || mode == "all") {
+        const double cpu = cpuSeconds();
         const Stopwatch w;
         const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, o, RunContext::silent());
-        report("bunny_cgal_75k at 400 mm, printer 200 mm^3", bunny.mesh, frame.outermost, r, w.seconds());
+        report("bunny_cgal_75k at 400 mm, printer 200 mm^3", bunny.mesh, frame.outermost, r, w.seconds(), cpuSeconds() - cpu);
     }
-    if (mode == "million" || mode == "compare" || mode == "all") {
+    if (mode == "compare") compare("bunny_cgal_75k at 400 mm, printer 200 mm^3", bunny.mesh);
+    if (mode == "million" || mode == "compare-million" || mode == "all") {
         const TriMesh fine = test::subdivide(bunny.mesh, 2);
-        const Stopwatch w;
-        const PartitionResult r = partitionSurface(fine, frame.structure, frame.outermost, o, RunContext::silent());
-        report("bunny_cgal_75k subdivided twice (1-to-4 midpoint), 400 mm", fine, frame.outermost, r, w.seconds());
-        if (mode == "compare") {
-            PartitionOptions full = o;
-            full.graphNodeTarget = 0;
-            const Stopwatch w2;
-            const PartitionResult rf = partitionSurface(fine, frame.structure, frame.outermost, full, RunContext::silent());
-            report("same, without clustering (every face a graph-cut node)", fine, frame.outermost, rf, w2.seconds());
-            const FaceGraph g = buildFaceGraph(fine);
-            size_t differ = 0;
-            for (size_t f = 0; f < fine.triangles.size(); ++f)
-                differ += r.graphCutLabels[f] != rf.graphCutLabels[f] ? 1 : 0;
-            const auto sa = seamFaces(g, r.facePieces), sb = seamFaces(g, rf.facePieces);
-            const auto [mean1, max1] = seamDistance(g, sa, sb);
-            const auto [mean2, max2] = seamDistance(g, sb, sa);
-            std::printf("clustered vs full: graph-cut labels differ on %.2f%% of faces; final seams: clustered -> full "
-                        "mean %.2f mm max %.2f mm, full -> clustered mean %.2f mm max %.2f mm\n",
-                        100.0 * double(differ) / double(fine.triangles.size()), mean1, max1, mean2, max2);
+        if (mode == "compare-million") {
+            compare("bunny_cgal_75k subdivided twice (1-to-4 midpoint), 400 mm", fine);
+        } else {
+            const double cpu = cpuSeconds();
+            const Stopwatch w;
+            const PartitionResult r = partitionSurface(fine, frame.structure, frame.outermost, o, RunContext::silent());
+            report("bunny_cgal_75k subdivided twice (1-to-4 midpoint), 400 mm", fine, frame.outermost, r, w.seconds(),
+                   cpuSeconds() - cpu);
         }
     }
     return 0;

@@ -82,12 +82,18 @@ int main(int argc, char** argv) {
     app.add_option("-k,--candidates", opt.candidateCount, "Candidate labels per triangle: its k nearest balls")
         ->default_val(opt.candidateCount)->check(CLI::PositiveNumber);
     app.add_option("--w-smoothness", opt.smoothnessStart, "First w_smoothness of the fit schedule")->default_val(opt.smoothnessStart);
+    app.add_option("--w-smoothness-factor", opt.smoothnessFactor, "Multiply w_smoothness by this while a partition does not fit")
+        ->default_val(opt.smoothnessFactor);
+    app.add_option("--w-smoothness-min", opt.smoothnessMin, "The schedule bottoms out below this w_smoothness")
+        ->default_val(opt.smoothnessMin);
     app.add_option("--w-saliency", opt.saliencyWeight, "w_saliency")->default_val(opt.saliencyWeight);
     app.add_option("--fit-margin-mm", opt.fitMarginMm, "Grow each side of a piece's box by this before the fit test")
         ->default_val(opt.fitMarginMm);
     app.add_option("--min-piece-area-mm2", opt.minPieceAreaMm2, "Merge smaller pieces into a neighbour when it fits")
         ->default_val(opt.minPieceAreaMm2);
     app.add_option("--svm-cost", opt.svm.cost, "liblinear C for the planar cuts")->default_val(opt.svm.cost);
+    app.add_option("--svm-samples", opt.svmMaxSamples, "Train the planar cuts on at most this many faces")
+        ->default_val(opt.svmMaxSamples)->check(CLI::PositiveNumber);
     app.add_flag("--one-vs-rest", oneVsRest, "One-vs-rest SVMs instead of Crammer-Singer (both give argmax cells)");
     app.add_option("--graph-nodes", opt.graphNodeTarget, "Cluster faces above this many graph-cut nodes (0 = never)")
         ->default_val(opt.graphNodeTarget);

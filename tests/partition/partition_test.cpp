@@ -120,9 +120,30 @@ TEST_CASE("partition: a salient belt across the natural seam is never cut") {
     CHECK(kept.pieces.size() == 2);
     CHECK(isKeptWhole(sphere, kept, belt));
 
-    // The same with a sphere of saliency where the seam would cross the top, given by face index
-    // list and by sphere.
+    // Without the retraining rounds, a crossed belt is either merged into one piece or reported:
+    // never crossed silently.
+    {
+        PartitionOptions noRetry = o;
+        noRetry.salientRetries = 0;
+        RunContext log;
+        const PartitionResult r = partitionSurface(sphere, frame, {0, 1}, noRetry, log);
+        const bool isWarned = !log.warnings().empty();
+        CHECK((isKeptWhole(sphere, r, belt) ? r.salientRegionsSplit == 0 && !isWarned
+                                            : r.salientRegionsSplit == 1 && isWarned));
+    }
+
+    // The same belt given as a list of face indices.
     sphere.salientFaces.clear();
+    {
+        PartitionOptions byIndex = o;
+        for (uint32_t f = 0; f < belt.size(); ++f)
+            if (belt[f]) byIndex.salientFaceIndices.push_back(f);
+        const PartitionResult r = partitionSurface(sphere, frame, {0, 1}, byIndex, RunContext::silent());
+        CHECK(r.salientFaces == belt);
+        CHECK(isKeptWhole(sphere, r, belt));
+    }
+
+    // A sphere of saliency where the seam would cross the top.
     PartitionOptions bySphere = o;
     bySphere.salientSpheres.push_back({{0, 0, 100}, 30.0});
     const PartitionResult capped = partitionSurface(sphere, frame, {0, 1}, bySphere, RunContext::silent());
@@ -148,6 +169,35 @@ TEST_CASE("partition: small bunny, energies, pieces, determinism across thread c
     CHECK(r.cells.cellCount() >= 2);
     CHECK(r.svmAgreement > 0.8);
     for (const Piece& p : r.pieces) CHECK_FALSE(p.balls.empty());
+    // The cells of a real result: sampled points of the mesh's bounding box each lie in exactly
+    // one cell (argmax with a strict winner), and segments between points of one cell stay in it.
+    {
+        const Box3d box = boundingBox(bunny.mesh);
+        std::mt19937 rng(5);
+        std::vector<std::vector<Vec3d>> members(r.cells.cellCount());
+        size_t ambiguous = 0;
+        for (int i = 0; i < 20000; ++i) {
+            Vec3d x;
+            for (int a = 0; a < 3; ++a)
+                x[size_t(a)] = std::uniform_real_distribution<double>(box.min[size_t(a)], box.max[size_t(a)])(rng);
+            int winners = 0;
+            double best = -1e300;
+            for (uint32_t k = 0; k < r.cells.cellCount(); ++k) best = std::max(best, r.cells.score(k, x));
+            for (uint32_t k = 0; k < r.cells.cellCount(); ++k) winners += r.cells.score(k, x) == best ? 1 : 0;
+            ambiguous += winners == 1 ? 0 : 1;
+            members[r.cells.cellAt(x)].push_back(x);
+        }
+        CHECK(ambiguous == 0);
+        size_t outside = 0;
+        for (uint32_t k = 0; k < r.cells.cellCount(); ++k)
+            for (size_t i = 0; i + 1 < members[k].size(); ++i) {
+                const Vec3d& a = members[k][i];
+                const Vec3d& b = members[k][i + 1];
+                const Vec3d mid{0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])};
+                outside += r.cells.cellAt(mid) == k ? 0 : 1;
+            }
+        CHECK(outside == 0);
+    }
     // The schedule lowers w_smoothness by 10× per step and records each.
     for (size_t i = 1; i < r.schedule.size(); ++i)
         CHECK(r.schedule[i].smoothnessWeight == doctest::Approx(0.1 * r.schedule[i - 1].smoothnessWeight));

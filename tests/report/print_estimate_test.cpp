@@ -45,18 +45,16 @@ TEST_CASE("print_estimate: the breakdown of a 20 mm cube follows the documented 
     const double pi = std::acos(-1.0);
     const double spacing = 0.45 - 0.2 * (1.0 - pi / 4.0);
     const double wall = 0.45 + 2.0 * spacing;  // 3 perimeters, horizontal thickness
-    CHECK(e.externalPerimeterMm3 + e.innerPerimeterMm3 == doctest::Approx(4 * 400.0 * wall));
-    CHECK(e.externalPerimeterMm3 == doctest::Approx(4 * 400.0 * 0.45));
+    CHECK(e.perimeterMm3 == doctest::Approx(4 * 400.0 * wall));
     CHECK(e.solidMm3 == doctest::Approx(400.0 * 1.0 + 400.0 * (0.27 + 4 * 0.2)));  // top 5 layers, bottom 5
     const double interior = 8000.0 - 4 * 400.0 * wall - 400.0 * 2.07;
     CHECK(e.infillMm3 == doctest::Approx(interior * 0.2 * PrintRates{}.sparseInfillFactor));
-    CHECK(e.filamentMm3 == doctest::Approx(e.externalPerimeterMm3 + e.innerPerimeterMm3 + e.solidMm3 + e.infillMm3));
+    CHECK(e.filamentMm3 == doctest::Approx(e.perimeterMm3 + e.solidMm3 + e.infillMm3));
     CHECK(e.layers == 100);  // 0.27 + 99 × 0.2 ≥ 20
     CHECK(e.partVolumeMm3 == doctest::Approx(8000.0));
     const PrintRates r;
-    CHECK(e.seconds == doctest::Approx(e.externalPerimeterMm3 * r.externalPerimeterSPerMm3 +
-                                       e.innerPerimeterMm3 * r.innerPerimeterSPerMm3 + e.solidMm3 * r.solidSPerMm3 +
-                                       e.infillMm3 * r.sparseInfillSPerMm3 + 100 * r.layerS));
+    CHECK(e.seconds == doctest::Approx(e.perimeterMm3 * r.perimeterSPerMm3 + e.solidMm3 * r.solidSPerMm3 +
+                                       e.infillMm3 * r.sparseInfillSPerMm3));
 }
 
 TEST_CASE("print_estimate: solid parts use all their volume; thin walls are all shell") {
@@ -99,7 +97,8 @@ TEST_CASE("print_estimate: fitsPrinter tries the axis permutations") {
     CHECK(fitsPrinter({250, 100, 100}, {100, 100, 250}));
     CHECK(fitsPrinter({200, 200, 200}, {200, 200, 200}));
     CHECK_FALSE(fitsPrinter({201, 10, 10}, {200, 200, 200}));
-    CHECK_FALSE(fitsPrinter({150, 150, 10}, {100, 200, 200}));
+    CHECK(fitsPrinter({150, 150, 10}, {100, 200, 200}));  // 10 mm along the 100 mm side
+    CHECK_FALSE(fitsPrinter({150, 150, 150}, {100, 200, 200}));
 }
 
 TEST_CASE("print_estimate: the octree baseline cuts until every part fits, and keeps the volume") {

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file Calibration of the print estimator against PrusaSlicer (not a ctest: it slices ~30 parts
 /// and takes a few minutes). Slices each calibration part at 20 % and 100 % infill, fits the
-/// sparse-infill factor and the time rates of report::PrintRates by least squares on relative
-/// errors, and prints the Markdown calibration table of docs/report.md for both the fitted and
+/// sparse-infill factor and the four time rates of report::PrintRates by least squares on
+/// relative errors, and prints the Markdown calibration table of docs/report.md for both the fitted and
 /// the compiled-in default rates. Usage: report_calibration [--tsv FILE] (prusa-slicer in PATH).
 #include <cmath>
 #include <cstdio>
@@ -22,8 +22,10 @@ namespace {
 struct Sample {
     std::string name;
     double infill = 0.0;
+    const TriMesh* mesh = nullptr;
     PrintEstimate model;  ///< with sparseInfillFactor = 1 (the breakdown is what is fitted)
     PrintEstimate slicer;
+    double areaMm2 = 0.0;
 };
 
 /// Solves the n×n system A x = b (Gaussian elimination, partial pivoting).
@@ -80,31 +82,25 @@ std::vector<double> fitNonNegative(const std::vector<std::vector<double>>& rows,
     }
 }
 
-double predictSeconds(const PrintEstimate& m, bool isSolid, const PrintRates& r, double infillScale) {
-    return m.externalPerimeterMm3 * r.externalPerimeterSPerMm3 + m.innerPerimeterMm3 * r.innerPerimeterSPerMm3 +
-           m.solidMm3 * r.solidSPerMm3 +
-           m.infillMm3 * infillScale * (isSolid ? r.solidInfillSPerMm3 : r.sparseInfillSPerMm3) +
-           double(m.layers) * r.layerS;
-}
-
 void printTable(const std::vector<Sample>& samples, const PrintRates& rates) {
     std::printf("| part | infill | PrusaSlicer h | estimate h | time error | PrusaSlicer cm³ | estimate cm³ | "
                 "filament error |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
-    double worstTime = 0.0, worstMaterial = 0.0;
+    double worstTime = 0.0, worstMaterial = 0.0, sumTime = 0.0, sumMaterial = 0.0;
     for (const Sample& s : samples) {
-        const bool isSolid = s.infill >= 100.0;
-        const double scale = isSolid ? 1.0 : rates.sparseInfillFactor;
-        const double seconds = predictSeconds(s.model, isSolid, rates, scale);
-        const double mm3 = s.model.externalPerimeterMm3 + s.model.innerPerimeterMm3 + s.model.solidMm3 +
-                           s.model.infillMm3 * scale;
-        const double te = 100.0 * (seconds / s.slicer.seconds - 1.0);
-        const double me = 100.0 * (mm3 / s.slicer.filamentMm3 - 1.0);
+        PrintSettings settings;
+        settings.infillPercent = s.infill;
+        const PrintEstimate e = estimatePrint(*s.mesh, settings, rates);
+        const double te = 100.0 * (e.seconds / s.slicer.seconds - 1.0);
+        const double me = 100.0 * (e.filamentMm3 / s.slicer.filamentMm3 - 1.0);
         worstTime = std::max(worstTime, std::abs(te));
         worstMaterial = std::max(worstMaterial, std::abs(me));
+        sumTime += te * te, sumMaterial += me * me;
         std::printf("| %s | %.0f%% | %.2f | %.2f | %+.1f%% | %.1f | %.1f | %+.1f%% |\n", s.name.c_str(), s.infill,
-                    s.slicer.seconds / 3600.0, seconds / 3600.0, te, s.slicer.filamentMm3 / 1000.0, mm3 / 1000.0, me);
+                    s.slicer.seconds / 3600.0, e.hours(), te, s.slicer.filamentMm3 / 1000.0, e.filamentMm3 / 1000.0, me);
     }
-    std::printf("\nlargest |error|: time %.1f%%, filament %.1f%%\n", worstTime, worstMaterial);
+    const double n = double(samples.size());
+    std::printf("\nlargest |error|: time %.1f%%, filament %.1f%%; rms: time %.1f%%, filament %.1f%%\n", worstTime,
+                worstMaterial, std::sqrt(sumTime / n), std::sqrt(sumMaterial / n));
 }
 
 }  // namespace
@@ -134,19 +130,18 @@ int main(int argc, char** argv) {
         {"bunny 100 mm", test::bunnyMm(100)},
         {"bunny 150 mm", test::bunnyMm(150)},
     };
-    PrintSettings base;
     PrintRates unit;  // breakdown only: factor 1
     unit.sparseInfillFactor = 1.0;
     std::vector<Sample> samples;
     for (const auto& [name, mesh] : parts)
         for (double infill : {20.0, 100.0}) {
-            PrintSettings s = base;
+            PrintSettings s;
             s.infillPercent = infill;
-            Sample sample{name, infill, estimatePrint(mesh, s, unit), sliceWithPrusaSlicer(mesh, s, name)};
+            Sample sample{name, infill, &mesh, estimatePrint(mesh, s, unit), sliceWithPrusaSlicer(mesh, s, name),
+                          meshAreaMm2(mesh)};
             std::fprintf(stderr, "%s %.0f%%: slicer %.0f s %.0f mm3, shell %.0f mm3 infill %.0f mm3 layers %zu\n",
                          name.c_str(), infill, sample.slicer.seconds, sample.slicer.filamentMm3,
-                         sample.model.externalPerimeterMm3 + sample.model.innerPerimeterMm3 + sample.model.solidMm3,
-                         sample.model.infillMm3, sample.model.layers);
+                         sample.model.perimeterMm3 + sample.model.solidMm3, sample.model.infillMm3, sample.model.layers);
             samples.push_back(sample);
         }
 
@@ -154,7 +149,7 @@ int main(int argc, char** argv) {
     double num = 0.0, den = 0.0;
     for (const Sample& s : samples) {
         if (s.infill >= 100.0 || s.model.infillMm3 <= 0.0) continue;
-        const double shell = s.model.externalPerimeterMm3 + s.model.innerPerimeterMm3 + s.model.solidMm3;
+        const double shell = s.model.perimeterMm3 + s.model.solidMm3;
         const double w = 1.0 / (s.slicer.filamentMm3 * s.slicer.filamentMm3);
         num += w * s.model.infillMm3 * (s.slicer.filamentMm3 - shell);
         den += w * s.model.infillMm3 * s.model.infillMm3;
@@ -162,28 +157,25 @@ int main(int argc, char** argv) {
     PrintRates fitted;
     fitted.sparseInfillFactor = den > 0.0 ? num / den : 1.0;
 
-    // 2. Time: seconds ≈ Σ volume_k · rate_k + layers · layerS.
+    // 2. Time: seconds ≈ Σ volume_k · rate_k.
     std::vector<std::vector<double>> rows;
     std::vector<double> y;
     for (const Sample& s : samples) {
         const bool isSolid = s.infill >= 100.0;
         const double infill = s.model.infillMm3 * (isSolid ? 1.0 : fitted.sparseInfillFactor);
-        rows.push_back({s.model.externalPerimeterMm3, s.model.innerPerimeterMm3, s.model.solidMm3,
-                        isSolid ? 0.0 : infill, isSolid ? infill : 0.0, double(s.model.layers)});
+        rows.push_back({s.model.perimeterMm3, s.model.solidMm3, isSolid ? 0.0 : infill, isSolid ? infill : 0.0});
         y.push_back(s.slicer.seconds);
     }
     const std::vector<double> x = fitNonNegative(rows, y);
-    fitted.externalPerimeterSPerMm3 = x[0];
-    fitted.innerPerimeterSPerMm3 = x[1];
-    fitted.solidSPerMm3 = x[2];
-    fitted.sparseInfillSPerMm3 = x[3];
-    fitted.solidInfillSPerMm3 = x[4];
-    fitted.layerS = x[5];
+    fitted.perimeterSPerMm3 = x[0];
+    fitted.solidSPerMm3 = x[1];
+    fitted.sparseInfillSPerMm3 = x[2];
+    fitted.solidInfillSPerMm3 = x[3];
 
-    std::printf("fitted: externalPerimeterSPerMm3 %.4f innerPerimeterSPerMm3 %.4f solidSPerMm3 %.4f "
-                "sparseInfillSPerMm3 %.4f solidInfillSPerMm3 %.4f layerS %.3f sparseInfillFactor %.4f\n\n",
-                fitted.externalPerimeterSPerMm3, fitted.innerPerimeterSPerMm3, fitted.solidSPerMm3,
-                fitted.sparseInfillSPerMm3, fitted.solidInfillSPerMm3, fitted.layerS, fitted.sparseInfillFactor);
+    std::printf("fitted: perimeterSPerMm3 %.4f solidSPerMm3 %.4f sparseInfillSPerMm3 %.4f solidInfillSPerMm3 %.4f "
+                "sparseInfillFactor %.4f\n\n",
+                fitted.perimeterSPerMm3, fitted.solidSPerMm3, fitted.sparseInfillSPerMm3, fitted.solidInfillSPerMm3,
+                fitted.sparseInfillFactor);
     std::printf("## with the fitted rates\n\n");
     printTable(samples, fitted);
     std::printf("\n## with the compiled-in defaults (report::PrintRates{})\n\n");
@@ -191,11 +183,11 @@ int main(int argc, char** argv) {
 
     if (!tsv.empty()) {
         std::ofstream out(tsv);
-        out << "part\tinfill\tslicer_s\tslicer_mm3\text_mm3\tinner_mm3\tsolid_mm3\tinfill_mm3\tlayers\tvolume_mm3\n";
+        out << "part\tinfill\tslicer_s\tslicer_mm3\tperimeter_mm3\tsolid_mm3\tinfill_mm3\tlayers\tvolume_mm3\tarea_mm2\n";
         for (const Sample& s : samples)
             out << s.name << '\t' << s.infill << '\t' << s.slicer.seconds << '\t' << s.slicer.filamentMm3 << '\t'
-                << s.model.externalPerimeterMm3 << '\t' << s.model.innerPerimeterMm3 << '\t' << s.model.solidMm3
-                << '\t' << s.model.infillMm3 << '\t' << s.model.layers << '\t' << s.model.partVolumeMm3 << '\n';
+                << s.model.perimeterMm3 << '\t' << s.model.solidMm3
+                << '\t' << s.model.infillMm3 << '\t' << s.model.layers << '\t' << s.model.partVolumeMm3 << '\t' << s.areaMm2 << '\n';
     }
     return 0;
 }

@@ -41,11 +41,11 @@ inline TriMesh sphereShell(const Vec3d& c, double radiusMm, double wallMm, int r
 
 /// A piece like the pipeline's: one octant of a spherical shell (outer radius @p radiusMm, wall
 /// @p wallMm), resting on z = 0 with its cut faces.
-inline TriMesh shellPiece(double radiusMm, double wallMm) {
+inline TriMesh shellPiece(double radiusMm, double wallMm, int rings = 48, int segments = 96) {
     Box3d octant;
     octant.min = {0, 0, 0};
     octant.max = {radiusMm + 1, radiusMm + 1, radiusMm + 1};
-    return report::clipToBox(sphereShell({0, 0, 0}, radiusMm, wallMm), octant);
+    return report::clipToBox(sphereShell({0, 0, 0}, radiusMm, wallMm, rings, segments), octant);
 }
 
 /// data/bunny_npm_3674.stl (y up) turned z up, scaled to @p heightMm, centred in x and y, on z = 0.

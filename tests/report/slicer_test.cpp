@@ -1,2 +1,119 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+/// @file PrusaSlicer as a subprocess, and the estimator checked against it: within 15 % on time
+/// and filament for a cube, a sphere and a hollow shell piece (the slicer cases are skipped, with
+/// a message, when prusa-slicer is not installed; `make test-deps` installs it).
 #include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "report_fixtures.h"
+#include "zomefab/core/error.h"
+#include "zomefab/report/cost_report.h"
+#include "zomefab/report/mesh_clip.h"
+#include "zomefab/report/slicer.h"
+
+using namespace zomefab;
+using namespace zomefab::report;
+using namespace zomefab::test;
+
+namespace {
+
+bool haveSlicer() {
+    static const bool have = isSlicerAvailable("prusa-slicer");
+    if (!have) MESSAGE("prusa-slicer is not installed: skipping the comparison with the real slicer");
+    return have;
+}
+
+void checkAgreement(const std::string& name, const TriMesh& part, double infill) {
+    PrintSettings s;
+    s.infillPercent = infill;
+    const PrintEstimate model = estimatePrint(part, s);
+    const PrintEstimate real = sliceWithPrusaSlicer(part, s, name);
+    const double timeError = model.seconds / real.seconds - 1.0;
+    const double filamentError = model.filamentMm3 / real.filamentMm3 - 1.0;
+    INFO(name << " at " << infill << "%: estimator " << model.hours() << " h " << model.filamentMm3
+              << " mm3, PrusaSlicer " << real.hours() << " h " << real.filamentMm3 << " mm3");
+    CHECK(std::abs(timeError) < 0.15);
+    CHECK(std::abs(filamentError) < 0.15);
+}
+
+}  // namespace
+
+TEST_CASE("slicer: PrusaSlicer's duration format") {
+    CHECK(parseSlicerDuration("1d 1h 49m 18s") == 86400 + 3600 + 49 * 60 + 18);
+    CHECK(parseSlicerDuration("2h 56m 34s") == 2 * 3600 + 56 * 60 + 34);
+    CHECK(parseSlicerDuration("59s") == 59);
+    CHECK(parseSlicerDuration("") < 0);
+    CHECK(parseSlicerDuration("12 minutes") < 0);
+    CHECK(parseSlicerDuration("3x") < 0);
+}
+
+TEST_CASE("slicer: the command line follows print-estimates.md and refuses nothing PrusaSlicer refuses") {
+    PrintSettings s;
+    const std::vector<std::string> hollow = prusaSlicerArguments(s);
+    auto valueOf = [](const std::vector<std::string>& args, const std::string& flag) {
+        for (size_t i = 0; i + 1 < args.size(); ++i)
+            if (args[i] == flag) return args[i + 1];
+        return std::string("<missing>");
+    };
+    CHECK(valueOf(hollow, "--fill-density") == "20%");
+    CHECK(valueOf(hollow, "--fill-pattern") == "triangles");
+    CHECK(valueOf(hollow, "--first-layer-height") == "0.27");
+    CHECK(valueOf(hollow, "--machine-limits-usage") == "time_estimate_only");
+    CHECK(valueOf(hollow, "--bed-shape") == "0x0,1000x0,1000x1000,0x1000");
+    s.infillPercent = 100;
+    // "The selected fill pattern is not supposed to work at 100% density": rectilinear instead.
+    CHECK(valueOf(prusaSlicerArguments(s), "--fill-pattern") == "rectilinear");
+}
+
+TEST_CASE("slicer: a missing slicer is a processing error naming it") {
+    SlicerOptions o;
+    o.executable = "/nonexistent/prusa-slicer";
+    CHECK_FALSE(isSlicerAvailable(o.executable));
+    bool thrown = false;
+    try {
+        sliceWithPrusaSlicer(makeBox({0, 0, 0}, {10, 10, 10}), PrintSettings{}, "cube", o);
+    } catch (const Error& e) {
+        thrown = true;
+        CHECK(e.code() == ErrorCode::ProcessingFailed);
+        CHECK(std::string(e.what()).find("/nonexistent/prusa-slicer") != std::string::npos);
+    }
+    CHECK(thrown);
+}
+
+TEST_CASE("slicer: the estimator agrees with PrusaSlicer within 15 %") {
+    if (!haveSlicer()) return;
+    // Small parts keep the slicer runs short (about a second each); docs/report.md has the full
+    // calibration table up to 100 mm parts and 150 mm bunnies.
+    checkAgreement("cube 40 mm", makeBox({0, 0, 0}, {40, 40, 40}), 20);
+    checkAgreement("cube 40 mm", makeBox({0, 0, 0}, {40, 40, 40}), 100);
+    checkAgreement("sphere 40 mm", makeSphere({0, 0, 20}, 20, 16, 32), 20);
+    const TriMesh piece = shellPiece(50, 12, 24, 48);
+    checkAgreement("shell piece R 50 mm, 12 mm wall", piece, 20);
+    checkAgreement("shell piece R 50 mm, 12 mm wall", piece, 100);
+}
+
+TEST_CASE("slicer: the cost report can take its numbers from PrusaSlicer") {
+    if (!haveSlicer()) return;
+    // Boxes slice fastest: a 40 mm cube, printed whole or as two halves of its 6 mm shell.
+    const TriMesh object = makeBox({0, 0, 0}, {40, 40, 40});
+    const TriMesh shell = hollowCube(40, 6);
+    const std::vector<TriMesh> pieces = {report::clipByPlane(shell, 2, 20.0, true),
+                                         report::clipByPlane(shell, 2, 20.0, false)};
+    zome::PartsList parts;
+    parts.balls = 8;
+    parts.struts[0][0] = 12;
+    CostOptions o;
+    o.source = EstimateSource::PrusaSlicer;
+    const CostReport real = costReport(object, pieces, parts, o);
+    const CostReport model = costReport(object, pieces, parts);
+    CHECK(costReportToJson(real)["source"] == "prusa-slicer");
+    for (size_t c = 0; c < 2; ++c) {
+        CHECK(real.cases[c].baseline.print.parts == 1);
+        CHECK(real.cases[c].zomefab.print.parts == 2);
+        CHECK(real.cases[c].zomefab.print.seconds > 0.0);
+        CHECK(model.cases[c].baseline.print.filamentMm3 ==
+              doctest::Approx(real.cases[c].baseline.print.filamentMm3).epsilon(0.15));
+    }
+}

@@ -60,11 +60,9 @@ ShellParts splitShell(const TriMesh& shell) {
 }  // namespace
 
 TEST_CASE("shell: a sphere's shell is two closed walls shellMm apart") {
-    const Vec3d c{0.4, -0.7, 50.2};
-    const double r = 50.0;
-    const TriMesh sphere = test::makeSphere(c, r, 128, 256);
-    ObjectFieldOptions objectOptions;
-    objectOptions.shellDepthMm = 16.0;
+    const Vec3d c{0.4, -0.7, 40.2};
+    const double r = 40.0;
+    const TriMesh sphere = test::makeSphere(c, r, 96, 192);
     MeshToLevelSetOptions options;
     options.interiorBandMm = 16.0;
     const LevelSet object = meshToLevelSet(sphere, options, RunContext::silent());
@@ -92,15 +90,15 @@ TEST_CASE("shell: a sphere's shell is two closed walls shellMm apart") {
 }
 
 TEST_CASE("shell: the bunny's wall is shellMm thick and closed") {
-    // The low-resolution bunny at 300 mm, 1 mm voxels, a 10 mm wall: seconds, and the ears stay hollow.
-    const TriMesh bunny = bunnyMm("bunny_npm_3674.stl", 300.0);
+    // The low-resolution bunny at 250 mm, 1 mm voxels, an 8 mm wall: seconds, and the ears stay hollow.
+    const TriMesh bunny = bunnyMm("bunny_npm_3674.stl", 250.0);
     ObjectFieldOptions options;
-    options.shellDepthMm = 12.0;
+    options.shellDepthMm = 8.0;
     MeshToLevelSetOptions levelSet;
     levelSet.interiorBandMm = options.shellDepthMm;
     const LevelSet object = meshToLevelSet(bunny, levelSet, RunContext::silent());
     ShellOptions shellOptions;
-    shellOptions.shellMm = 10.0;
+    shellOptions.shellMm = 8.0;
     const LevelSet shell = makeShell(object, shellOptions, RunContext::silent());
     const TriMesh mesh = levelSetToMesh(shell, {}, RunContext::silent());
     const ShellParts parts = splitShell(mesh);
@@ -116,8 +114,8 @@ TEST_CASE("shell: the bunny's wall is shellMm thick and closed") {
                              << test::quantile(thickness, 1));
     // Nowhere thinner than the wall; where the surface is convex or flat (most of it) exactly the
     // wall. Concave creases and parts thinner than two walls are legitimately thicker.
-    CHECK(test::quantile(thickness, 0.0) > 10.0 - 0.5 * voxel);
-    CHECK(test::quantile(thickness, 0.5) < 10.0 + 0.5 * voxel);
+    CHECK(test::quantile(thickness, 0.0) > 8.0 - 0.5 * voxel);
+    CHECK(test::quantile(thickness, 0.5) < 8.0 + 0.5 * voxel);
 }
 
 TEST_CASE("shell: options outside the allowed range are usage errors") {

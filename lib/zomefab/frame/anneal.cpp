@@ -4,6 +4,7 @@
 #include "zomefab/frame/anneal.h"
 
 #include <tbb/parallel_for.h>
+#include <time.h>
 
 #include <algorithm>
 #include <cmath>
@@ -48,10 +49,19 @@ nlohmann::json chainStatsToJson(const ChainStats& s) {
             {"accepted", s.accepted},
             {"moves", kinds},
             {"final_temperature", s.finalTemperature},
-            {"seconds", s.seconds}};
+            {"seconds", s.seconds},
+            {"cpu_seconds", s.cpuSeconds},
+            {"iterations_per_cpu_second", s.cpuSeconds > 0 ? double(s.iterations) / s.cpuSeconds : 0.0}};
 }
 
 namespace {
+
+/// CPU time of the calling thread in seconds.
+double threadCpuSeconds() {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
 
 constexpr uint64_t kChainSalt = 0x636861696E000000ull;  // "chain"
 constexpr uint32_t kNewBall = 0xFFFFFFFEu;
@@ -116,6 +126,7 @@ public:
             mLiveStruts.push_back(id);
         }
         resync();
+        mBestEnergy = mEnergy;
     }
 
     /// Runs the chain. @p tick, when set, is called every 1024 iterations with the current energy
@@ -124,6 +135,7 @@ public:
                     const std::function<void(double, double)>& tick = {}) {
         const AnnealOptions& a = mAnneal;
         const Stopwatch clock;
+        const double cpuStart = threadCpuSeconds();
         double t = a.initialTemperature;
         uint64_t reported = 0;
         uint64_t iter = 0;
@@ -147,7 +159,10 @@ public:
         mStats.iterations = iter;
         mStats.finalTemperature = t;
         mStats.seconds = clock.seconds();
-        ChainResult result{mS, frameEnergy(mS, mField, mEnergyOptions), mStats};
+        mStats.cpuSeconds = threadCpuSeconds() - cpuStart;
+        // The best state visited: the current one unless a saved copy is better.
+        const zome::Structure& best = (mIsBestSaved && mBestEnergy < mEnergy) ? mBest : mS;
+        ChainResult result{best, frameEnergy(best, mField, mEnergyOptions), mStats};
         return result;
     }
 
@@ -344,9 +359,43 @@ private:
         return true;
     }
 
-    /// InsStrut / InsBridge: a strut from a random ball through a random free hole, of a random
-    /// size, to the ball already at its end. InsStrut when the two balls share a neighbour (the
-    /// strut closes a triangle), InsBridge when they do not (path length > 2).
+    /// The @p k-th set bit of @p mask (0-based).
+    static int nthBit(uint64_t mask, uint32_t k) {
+        for (; k > 0; --k) mask &= mask - 1;
+        return __builtin_ctzll(mask);
+    }
+
+    /// InsStrut from the triangle table: a random ball a, a random strut a → c, a random strut
+    /// c → b; the proposal is the strut a → b when v(a→c) + v(c→b) is a catalogue strut
+    /// (MoveTables::closing) and both holes are free. It closes the triangle a, c, b.
+    bool proposeTriangleStrut(Proposal& p) {
+        const BallId a = mLiveBalls[mRng.below(uint32_t(mLiveBalls.size()))];
+        const uint64_t maskA = mBalls[a].mask;
+        if (maskA == 0) return false;
+        const int h1 = nthBit(maskA, mRng.below(uint32_t(__builtin_popcountll(maskA))));
+        const zome::Strut& s1 = mS.strut(mS.ball(a).holes[size_t(h1)]);
+        const BallId c = s1.a == a ? s1.b : s1.a;
+        const uint64_t maskC = mBalls[c].mask & ~bit(zome::oppositeHole(h1));
+        if (maskC == 0) return false;
+        const int h2 = nthBit(maskC, mRng.below(uint32_t(__builtin_popcountll(maskC))));
+        const zome::Strut& s2 = mS.strut(mS.ball(c).holes[size_t(h2)]);
+        const BallId b = s2.a == c ? s2.b : s2.a;
+        const int key = mTables.closing[size_t(strutKey(h1, s1.size))][size_t(strutKey(h2, s2.size))];
+        if (key < 0) return false;
+        const int hole = key / zome::kSizeCount, size = key % zome::kSizeCount;
+        const int holeB = zome::oppositeHole(hole);
+        if ((maskA & bit(hole)) || (mBalls[b].mask & bit(holeB))) return false;
+        p.kind = MoveKind::InsStrut;
+        setTouched(p, a, maskA | bit(hole));
+        setTouched(p, b, mBalls[b].mask | bit(holeB));
+        p.added[p.addedCount++] = existingStrut(a, hole, size, b);
+        finish(p, 0, +1);
+        return true;
+    }
+
+    /// InsBridge (or InsStrut): a strut from a random ball through a random free hole, of a
+    /// random size, to the ball already at its end. InsStrut when the two balls share a neighbour
+    /// (the strut closes a triangle), InsBridge when they do not (path length > 2).
     bool proposeStrutInsert(Proposal& p) {
         const BallId a = mLiveBalls[mRng.below(uint32_t(mLiveBalls.size()))];
         const int hole = int(mRng.below(zome::kHoleCount));
@@ -537,7 +586,7 @@ private:
         switch (mRng.below(6)) {
         case 0: isFeasible = proposeInsNode(p); break;
         case 1: isFeasible = proposeDelNode(p); break;
-        case 2:
+        case 2: isFeasible = proposeTriangleStrut(p); break;
         case 3: isFeasible = proposeStrutInsert(p); break;
         default: isFeasible = !mLiveStruts.empty() && proposeStrutDelete(p); break;
         }
@@ -549,8 +598,18 @@ private:
         const double u = mRng.uniform();
         if (!(deltaE <= 0.0 || u < std::exp(-deltaE / temperature))) return;
         ++mStats.passedMetropolis;
+        // Leaving the best state seen uphill: keep a copy of it first (returned if the chain ends
+        // worse; rare at low temperature, where most accepted moves go downhill).
+        if (deltaE > 0.0 && mEnergy <= mBestEnergy && !mIsBestSaved) {
+            mBest = mS;
+            mIsBestSaved = true;
+        }
         // CollisionFree(Z') and the other validity tests, then Z ← Z'.
         if (!commit(p)) return;
+        if (mEnergy < mBestEnergy) {
+            mBestEnergy = mEnergy;
+            mIsBestSaved = false;  // the best is the current state, not the copy
+        }
         ++mStats.accepted;
         ++mStats.acceptedByKind[size_t(p.kind)];
         if ((mStats.accepted & 0xFFFF) == 0) resync();
@@ -574,6 +633,9 @@ private:
     std::vector<BallId> mQueueA, mQueueB;
     std::vector<Edit> mLog;
     ChainStats mStats;
+    double mBestEnergy = 0;     ///< lowest energy visited
+    bool mIsBestSaved = false;  ///< mBest holds the state of mBestEnergy (the current one differs)
+    zome::Structure mBest;
 };
 
 void validate(const AnnealOptions& a, const EnergyOptions& e) {

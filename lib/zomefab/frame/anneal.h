@@ -59,7 +59,8 @@ struct ChainStats {
     std::array<uint64_t, kMoveKindCount> feasibleByKind{};
     std::array<uint64_t, kMoveKindCount> acceptedByKind{};
     double finalTemperature = 0;
-    double seconds = 0;
+    double seconds = 0;     ///< wall clock of the chain
+    double cpuSeconds = 0;  ///< CPU time of the chain's thread (robust to other load on the machine)
 };
 
 nlohmann::json chainStatsToJson(const ChainStats& stats);

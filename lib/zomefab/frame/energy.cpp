@@ -24,9 +24,8 @@ BallEnergy ballEnergy(uint64_t mask, double summand, const EnergyOptions& option
     BallEnergy e;
     e.isOutermost = isOutermostMask(mask);
     e.regularity = regularityOfMask(mask);
-    if (e.isOutermost) {
-        e.fidelity = summand;
-    } else {
+    if (e.isOutermost) e.fidelity = summand;
+    if (!e.isOutermost || !options.valenceOnInternalOnly) {
         const double dv = double(__builtin_popcountll(mask)) - options.targetValence;
         e.valence = dv * dv / options.targetValence;
     }

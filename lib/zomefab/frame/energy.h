@@ -21,6 +21,11 @@ struct EnergyOptions {
     double valenceWeight = 1.0;      ///< w_val
     double simplicityWeight = 1.0;   ///< w_sim
     double targetValence = 6.0;      ///< Eq. 5 (the cube lattice's valence)
+    /// Which balls E_val sums over (Eq. 5's N_in). false (default): every ball of the frame.
+    /// true: only the internal (non-outermost) balls, the literal reading, under which balls of
+    /// valence 1 and 2 (always outermost) cost nothing and the annealer tears the lattice into a
+    /// tree (docs/frame.md, "Valence").
+    bool valenceOnInternalOnly = false;
     /// τ of Eq. 6, the target number of items (balls + struts); > 0. Estimated by
     /// estimateTargetCount() before annealing (paper §4.3.4).
     double targetItemCount = 1.0;
@@ -52,7 +57,7 @@ struct BallEnergy {
     bool isOutermost = false;
     double fidelity = 0;    ///< fidelitySummand when outermost, else 0
     double regularity = 0;  ///< regularityOfMask
-    double valence = 0;     ///< (V − 6)²/6 when internal, else 0
+    double valence = 0;     ///< (V − 6)²/6 (only when internal if valenceOnInternalOnly)
 };
 
 /// The contribution of a ball with used holes @p mask and fidelity summand @p fidelitySummand.
@@ -83,7 +88,7 @@ struct EnergySums {
 
 /// E from the sums:
 ///   E_fid = Σ_out summand / |N_out|,  E_reg = Σ_balls regularity / (2|S|) (mean over strut ends),
-///   E_val = Σ_in (V − 6)²/6,  E_sim = (|N| + |S| − τ)²/τ.
+///   E_val = Σ (V − 6)²/6 over all (or the internal) balls,  E_sim = (|N| + |S| − τ)²/τ.
 EnergyTerms energyFromSums(const EnergySums& sums, const EnergyOptions& options);
 
 /// Only the weighted total (the annealing hot path).

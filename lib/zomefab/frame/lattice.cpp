@@ -11,7 +11,9 @@
 #include <vector>
 
 #include "zomefab/core/error.h"
+#include "zomefab/frame/energy.h"
 #include "zomefab/frame/frame_field.h"
+#include "zomefab/frame/outermost.h"
 
 namespace zomefab::frame {
 
@@ -25,12 +27,34 @@ struct Placement {
     int lo[3] = {0, 0, 0};    ///< index range [lo, lo + n)
     int n[3] = {0, 0, 0};
     std::vector<uint8_t> isCube;  ///< per cell (i,j,k) in [lo, lo+n−1)
+    std::vector<uint8_t> edge;    ///< [3·point + axis]: the strut to the +axis neighbour is in a cube
+    std::vector<uint8_t> isBall;  ///< per point: a corner of a cube
     size_t cubes = 0;
+    /// Mean E_fid summand of the outermost cube balls: the tie-break between placements with as
+    /// many cubes (the one whose boundary lies closer to the surface).
+    double fidelity = 0;
 
     size_t index(int i, int j, int k) const {
         return (size_t(i - lo[0]) * size_t(n[1]) + size_t(j - lo[1])) * size_t(n[2]) + size_t(k - lo[2]);
     }
 };
+
+/// The holes of the B0 struts along +x, +y, +z and −x, −y, −z.
+struct AxisHoles {
+    int plus[3], minus[3];
+    AxisHoles() {
+        for (int a = 0; a < 3; ++a) {
+            zome::GoldenVector3 v;
+            v[a] = zome::Golden(2, 2);
+            plus[a] = zome::matchStrut(v)->hole;
+            minus[a] = zome::oppositeHole(plus[a]);
+        }
+    }
+};
+const AxisHoles& axisHoles() {
+    static const AxisHoles holes;
+    return holes;
+}
 
 /// Frame-space box of the field's box rotated by −rotation about z.
 Box3d frameBox(const FrameField& ff) {
@@ -110,6 +134,40 @@ Placement evaluate(const FrameField& ff, double rotationDeg, const Vec3d& offset
                     ++pl.cubes;
                 }
             }
+    // Balls and struts of the whole cubes, the hole masks they give, and the fidelity tie-break.
+    pl.isBall.assign(count, 0);
+    pl.edge.assign(3 * count, 0);
+    for (int i = pl.lo[0]; i + 1 < pl.lo[0] + pl.n[0]; ++i)
+        for (int j = pl.lo[1]; j + 1 < pl.lo[1] + pl.n[1]; ++j)
+            for (int k = pl.lo[2]; k + 1 < pl.lo[2] + pl.n[2]; ++k) {
+                if (!pl.isCube[pl.index(i, j, k)]) continue;
+                for (int c = 0; c < 8; ++c)
+                    pl.isBall[pl.index(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))] = 1;
+                for (int a = 0; a < 3; ++a)
+                    for (int c = 0; c < 4; ++c) {
+                        int e[3] = {i, j, k};
+                        e[(a + 1) % 3] += c & 1;
+                        e[(a + 2) % 3] += (c >> 1) & 1;
+                        pl.edge[3 * pl.index(e[0], e[1], e[2]) + size_t(a)] = 1;
+                    }
+            }
+    const AxisHoles& holes = axisHoles();
+    std::vector<uint64_t> mask(count, 0);
+    const size_t stride[3] = {size_t(pl.n[1]) * size_t(pl.n[2]), size_t(pl.n[2]), 1};
+    for (size_t id = 0; id < count; ++id)
+        for (int a = 0; a < 3; ++a)
+            if (pl.edge[3 * id + size_t(a)]) {
+                mask[id] |= uint64_t(1) << holes.plus[a];
+                mask[id + stride[a]] |= uint64_t(1) << holes.minus[a];
+            }
+    double sum = 0;
+    size_t outermost = 0;
+    for (size_t id = 0; id < count; ++id)
+        if (pl.isBall[id] && isOutermostMask(mask[id])) {
+            sum += fidelitySummand(depth[id], ff);
+            ++outermost;
+        }
+    pl.fidelity = outermost ? sum / double(outermost) : 0.0;
     return pl;
 }
 
@@ -143,6 +201,7 @@ LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptio
 
     // Offsets are relative to the min corner of the frame-space box of each rotation.
     std::vector<size_t> cubes(total, 0);
+    std::vector<double> fidelity(total, 0.0);
     std::vector<FrameField> fields;
     std::vector<Vec3d> corners;
     for (double r : rotations) {
@@ -158,11 +217,16 @@ LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptio
     };
     tbb::parallel_for(size_t(0), total, [&](size_t p) {
         if (context.isCancelled()) return;
-        cubes[p] = evaluate(fields[p / perRotation], rotations[p / perRotation], offsetOf(p)).cubes;
+        const Placement pl = evaluate(fields[p / perRotation], rotations[p / perRotation], offsetOf(p));
+        cubes[p] = pl.cubes;
+        fidelity[p] = pl.fidelity;
     });
     context.throwIfCancelled();
-    // The first maximum in placement order: deterministic whatever the thread count.
-    const size_t best = size_t(std::max_element(cubes.begin(), cubes.end()) - cubes.begin());
+    // Most cubes, then the lowest boundary fidelity, then the first in placement order:
+    // deterministic whatever the thread count.
+    size_t best = 0;
+    for (size_t p = 1; p < total; ++p)
+        if (cubes[p] > cubes[best] || (cubes[p] == cubes[best] && fidelity[p] < fidelity[best])) best = p;
     if (cubes[best] == 0) {
         const double deepest = deepestDepthMm(field);
         const double need = options.zone.dMinMm + options.scale.ballRadiusMm();
@@ -177,24 +241,10 @@ LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptio
     const FrameField& ff = fields[best / perRotation];
     const Placement pl = evaluate(ff, rotations[best / perRotation], offsetOf(best));
 
-    // Balls and struts of the whole cubes; union-find over lattice points for the components.
+    // Union-find over lattice points for the connected parts.
     const size_t count = pl.isCube.size();
-    std::vector<uint8_t> isBall(count, 0);
-    std::vector<uint8_t> edge(3 * count, 0);
-    for (int i = pl.lo[0]; i + 1 < pl.lo[0] + pl.n[0]; ++i)
-        for (int j = pl.lo[1]; j + 1 < pl.lo[1] + pl.n[1]; ++j)
-            for (int k = pl.lo[2]; k + 1 < pl.lo[2] + pl.n[2]; ++k) {
-                if (!pl.isCube[pl.index(i, j, k)]) continue;
-                for (int c = 0; c < 8; ++c)
-                    isBall[pl.index(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))] = 1;
-                for (int a = 0; a < 3; ++a)
-                    for (int c = 0; c < 4; ++c) {
-                        int e[3] = {i, j, k};
-                        e[(a + 1) % 3] += c & 1;
-                        e[(a + 2) % 3] += (c >> 1) & 1;
-                        edge[3 * pl.index(e[0], e[1], e[2]) + size_t(a)] = 1;
-                    }
-            }
+    const std::vector<uint8_t>& isBall = pl.isBall;
+    const std::vector<uint8_t>& edge = pl.edge;
     std::vector<size_t> parent(count);
     std::iota(parent.begin(), parent.end(), size_t(0));
     auto find = [&](size_t x) {

@@ -2,7 +2,8 @@
 /// @file The initial frame (paper §4.2): cubes of B0 blue struts along the three blue axes x, y, z,
 /// every ball and strut clear of the forbidden zone (dMin, ball and strut radii accounted for).
 /// The lattice offset (and optionally its rotation about the up axis z) is searched to maximise
-/// the number of whole cubes; the largest connected part is kept. docs/frame.md, "Initial lattice".
+/// the number of whole cubes (ties: the lowest mean E_fid summand of the boundary balls, then the
+/// first placement); the largest connected part is kept. docs/frame.md, "Initial lattice".
 #pragma once
 
 #include <cstddef>

@@ -31,6 +31,15 @@ MoveTables buildMoveTables() {
             }
         }
     }
+    // Closing: v1 + v2 looked up exactly (a triangle a → c → b closed by a → b).
+    for (int k1 = 0; k1 < kHoleCount * kSizeCount; ++k1) {
+        for (int k2 = 0; k2 < kHoleCount * kSizeCount; ++k2) {
+            const GoldenVector3 sum = strutVector(k1 / kSizeCount, k1 % kSizeCount) +
+                                      strutVector(k2 / kSizeCount, k2 % kSizeCount);
+            const std::optional<StrutMatch> m = sum.isZero() ? std::nullopt : matchStrut(sum);
+            t.closing[size_t(k1)][size_t(k2)] = m ? int16_t(strutKey(m->hole, m->size)) : int16_t(-1);
+        }
+    }
     // Splits: v = v1 + v2 with v1, v2 catalogue struts; v2 = v − v1 looked up exactly.
     for (int h = 0; h < kHoleCount; ++h) {
         for (int s = 0; s < kSizeCount; ++s) {

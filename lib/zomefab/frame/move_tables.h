@@ -25,6 +25,10 @@ inline int strutKey(int hole, int size) { return hole * zome::kSizeCount + size;
 struct MoveTables {
     /// Every split of each (hole, size), ordered by (hole1, size1); 186 lists.
     std::array<std::vector<SplitEntry>, zome::kHoleCount * zome::kSizeCount> splits;
+    /// Triangle closing (the merge table of InsStrut): closing[k1][k2] = strutKey of the strut
+    /// v(k1) + v(k2) when that sum is a catalogue strut, else −1. k = strutKey(hole, size).
+    std::array<std::array<int16_t, zome::kHoleCount * zome::kSizeCount>, zome::kHoleCount * zome::kSizeCount>
+        closing{};
     /// cos of the angle between holes i and j.
     std::array<std::array<double, zome::kHoleCount>, zome::kHoleCount> cosine{};
     /// |θ_ij − π/2| in radians, exactly 0 for perpendicular holes (exact dot product zero) and

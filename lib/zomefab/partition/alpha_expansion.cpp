@@ -141,14 +141,17 @@ public:
                     // E00 + E11 ≤ E01 + E10 (Kolmogorov & Zabih 2004).
                     const double a = fu != fv ? w : 0.0;
                     e0 += a;
-                    g.add_edge(int(i), nv, w - a, w);
+                    g.add_edge(int(i), nv, float(w - a), float(w));
                 } else {
                     // v keeps its label fv (it cannot take alpha, or already has it).
                     if (fu != fv) e0 += w;
                     if (alpha != fv) e1 += w;
                 }
             }
-            g.add_tweights(int(i), e1, e0);  // cap_source is paid when x = 1, cap_sink when x = 0
+            // cap_source is paid when x = 1, cap_sink when x = 0; only the difference matters, and
+            // taking it in double keeps the float capacities exact enough.
+            const double d = e1 - e0;
+            g.add_tweights(int(i), float(d > 0.0 ? d : 0.0), float(d < 0.0 ? -d : 0.0));
         }
         g.maxflow();
 

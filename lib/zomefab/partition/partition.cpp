@@ -8,9 +8,9 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <numeric>
 #include <string>
-#include <tuple>
 
 #include "zomefab/core/error.h"
 #include "zomefab/partition/alpha_expansion.h"
@@ -83,6 +83,25 @@ NearestBalls nearestBalls(const std::vector<Vec3d>& queries, const std::vector<V
     const int kk = out.k;
     out.labels.resize(queries.size() * size_t(kk));
     out.distancesMm.resize(queries.size() * size_t(kk));
+    auto store = [&](size_t q, const std::vector<std::pair<double, uint32_t>>& best) {
+        for (int i = 0; i < kk; ++i) {
+            out.labels[q * size_t(kk) + size_t(i)] = best[size_t(i)].second;
+            out.distancesMm[q * size_t(kk) + size_t(i)] = std::sqrt(best[size_t(i)].first);
+        }
+    };
+    if (balls.size() <= 512) {
+        // Few balls (a frame has a few hundred outermost balls): a linear scan beats the grid.
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, queries.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+            std::vector<std::pair<double, uint32_t>> all(balls.size());
+            for (size_t q = r.begin(); q < r.end(); ++q) {
+                for (uint32_t i = 0; i < balls.size(); ++i) all[i] = {dist2(queries[q], balls[i]), i};
+                std::nth_element(all.begin(), all.begin() + (kk - 1), all.end());
+                std::sort(all.begin(), all.begin() + kk);
+                store(q, all);
+            }
+        });
+        return out;
+    }
     Box3d box;
     for (const Vec3d& b : balls) box.expand(b);
     std::array<int, 3> dims;
@@ -130,10 +149,7 @@ NearestBalls nearestBalls(const std::vector<Vec3d>& queries, const std::vector<V
                 // Balls in rings beyond this one are at least ring·cell away.
                 if (int(best.size()) == kk && best.back().first <= double(ring) * cellMm * double(ring) * cellMm) break;
             }
-            for (int i = 0; i < kk; ++i) {
-                out.labels[q * size_t(kk) + size_t(i)] = best[size_t(i)].second;
-                out.distancesMm[q * size_t(kk) + size_t(i)] = std::sqrt(best[size_t(i)].first);
-            }
+            store(q, best);
         }
     });
     return out;
@@ -143,7 +159,7 @@ NearestBalls nearestBalls(const std::vector<Vec3d>& queries, const std::vector<V
 
 struct Units {
     std::vector<uint32_t> unitOf;   ///< per face
-    std::vector<uint32_t> offsets;  ///< CSR unit → faces
+    std::vector<uint32_t> offsets{0};  ///< CSR unit → faces
     std::vector<uint32_t> faces;
     size_t count() const { return offsets.size() - 1; }
 };
@@ -154,7 +170,6 @@ Units buildUnits(const FaceGraph& g, const std::vector<uint8_t>& salient, size_t
     Units u;
     const size_t n = g.faceCount();
     u.unitOf.assign(n, kNone);
-    u.offsets.push_back(0);
     std::vector<uint32_t> queue;
     for (size_t seed = 0; seed < n; ++seed) {
         if (u.unitOf[seed] != kNone) continue;
@@ -384,358 +399,522 @@ std::vector<uint8_t> salientFaceFlags(const TriMesh& mesh, const std::vector<Sal
 
 // --- the stage --------------------------------------------------------------------------------
 
-PartitionResult partitionSurface(const TriMesh& meshMm, const zome::Structure& frame,
-                                 const std::vector<zome::BallId>& labelBalls, const PartitionOptions& opt,
-                                 const RunContext& run) {
-    const Stopwatch total;
-    checkPartitionOptions(opt, frame.scale());
-    if (meshMm.triangles.empty()) throw Error(ErrorCode::InvalidInput, "the mesh has no triangles");
-    if (labelBalls.empty())
-        throw Error(ErrorCode::InvalidInput, "the frame has no outermost balls to attach pieces to" +
-                                                 std::string(frame.ballCount() == 0 ? " (it has no balls at all)" : ""));
-    {
-        std::vector<zome::BallId> sorted(labelBalls);
+namespace {
+
+/// One run of the stage: the inputs, the derived geometry and the problems, and one method per
+/// phase (docs/partition.md sections 1–6).
+class Stage {
+public:
+    Stage(const TriMesh& meshMm, const zome::Structure& frame, const std::vector<zome::BallId>& labelBalls,
+          const PartitionOptions& opt, const RunContext& run)
+        : mMesh(meshMm), mFrame(frame), mLabelBalls(labelBalls), mOpt(opt), mRun(run),
+          mFaceCount(meshMm.triangles.size()), mLabelCount(uint32_t(labelBalls.size())),
+          mB0(frame.scale().b0Mm) {}
+
+    PartitionResult run() {
+        const Stopwatch total;
+        checkInputs();
+        mRun.progress("partition", 0.0);
+        prepareSurface();
+        prepareProblems();
+        mRun.throwIfCancelled();
+        runSchedule();
+        cutAndMakePieces();
+        mRes.secondsTotal = total.seconds();
+        mRun.progress("partition", 1.0);
+        return std::move(mRes);
+    }
+
+private:
+    // --- inputs ---------------------------------------------------------------------------------
+
+    void checkInputs() {
+        checkPartitionOptions(mOpt, mFrame.scale());
+        if (mMesh.triangles.empty()) throw Error(ErrorCode::InvalidInput, "the mesh has no triangles");
+        if (mLabelBalls.empty())
+            throw Error(ErrorCode::InvalidInput,
+                        "the frame has no outermost balls to attach pieces to" +
+                            std::string(mFrame.ballCount() == 0 ? " (it has no balls at all)" : ""));
+        std::vector<zome::BallId> sorted(mLabelBalls);
         std::sort(sorted.begin(), sorted.end());
         for (size_t i = 0; i < sorted.size(); ++i) {
-            if (!frame.hasBall(sorted[i]))
+            if (!mFrame.hasBall(sorted[i]))
                 throw Error(ErrorCode::InvalidInput, "label ball " + std::to_string(sorted[i]) + " is not a ball of the frame");
             if (i > 0 && sorted[i] == sorted[i - 1])
                 throw Error(ErrorCode::InvalidInput, "label ball " + std::to_string(sorted[i]) + " is listed twice");
         }
-    }
-    const double b0 = frame.scale().b0Mm;
-    const size_t faceCount = meshMm.triangles.size();
-    const uint32_t labelCount = uint32_t(labelBalls.size());
+        mRes.b0Mm = mB0;
+        mRes.printerMm = mOpt.printerMm;
+        mRes.fitMarginMm = mOpt.fitMarginMm;
+        mRes.labelBalls = mLabelBalls;
 
-    PartitionResult res;
-    res.b0Mm = b0;
-    res.printerMm = opt.printerMm;
-    res.fitMarginMm = opt.fitMarginMm;
-    res.labelBalls = labelBalls;
-
-    // Mesh/frame mismatch: the frame sits inside the shell, so every label ball lies inside the
-    // mesh's bounding box (one b0 of slack for rounding and open meshes).
-    std::vector<Vec3d> ballMm(labelCount);
-    for (uint32_t l = 0; l < labelCount; ++l) ballMm[l] = frame.ball(labelBalls[l]).positionMm;
-    {
-        const Box3d box = boundingBox(meshMm);
-        for (uint32_t l = 0; l < labelCount; ++l) {
+        // Mesh/frame mismatch: the frame sits inside the shell, so every label ball lies inside the
+        // mesh's bounding box (one b0 of slack for rounding and open meshes).
+        mBallMm.resize(mLabelCount);
+        for (uint32_t l = 0; l < mLabelCount; ++l) mBallMm[l] = mFrame.ball(mLabelBalls[l]).positionMm;
+        const Box3d box = boundingBox(mMesh);
+        for (uint32_t l = 0; l < mLabelCount; ++l) {
             double out = 0.0;
-            for (int a = 0; a < 3; ++a)
-                out = std::max({out, box.min[size_t(a)] - ballMm[l][size_t(a)], ballMm[l][size_t(a)] - box.max[size_t(a)]});
-            if (out > b0)
+            for (size_t a = 0; a < 3; ++a) out = std::max({out, box.min[a] - mBallMm[l][a], mBallMm[l][a] - box.max[a]});
+            if (out > mB0)
                 throw Error(ErrorCode::InvalidInput,
-                            "frame and mesh do not match: ball " + std::to_string(labelBalls[l]) +
-                                fmt(" at (%.1f, %.1f, %.1f) mm", ballMm[l][0], ballMm[l][1], ballMm[l][2]) +
+                            "frame and mesh do not match: ball " + std::to_string(mLabelBalls[l]) +
+                                fmt(" at (%.1f, %.1f, %.1f) mm", mBallMm[l][0], mBallMm[l][1], mBallMm[l][2]) +
                                 fmt(" lies %.1f mm outside the mesh's bounding box (check transform_mm)", out));
         }
     }
 
-    run.progress("partition", 0.0);
-    const FaceGraph graph = buildFaceGraph(meshMm);
-    res.salientFaces = salientFaceFlags(meshMm, opt.salientSpheres, opt.salientFaceIndices);
+    /// Face graph, salient regions, the k nearest balls of every face (Eq. 2) and the Eq. (3)
+    /// weight of every face pair.
+    void prepareSurface() {
+        mGraph = buildFaceGraph(mMesh);
+        mRes.salientFaces = salientFaceFlags(mMesh, mOpt.salientSpheres, mOpt.salientFaceIndices);
 
-    // Salient regions: edge-connected salient faces.
-    std::vector<uint32_t> salientRegionOf(faceCount, kNone);
-    {
-        std::vector<uint32_t> tag(faceCount);
-        for (size_t f = 0; f < faceCount; ++f) tag[f] = res.salientFaces[f] ? 0u : uint32_t(f + 1);  // non-salient: unique
-        std::vector<uint32_t> comp;
-        labelComponents(graph, tag, comp);
+        // Salient regions: edge-connected salient faces.
+        mSalientRegionOf.assign(mFaceCount, kNone);
+        std::vector<uint32_t> tag(mFaceCount), comp;
+        for (size_t f = 0; f < mFaceCount; ++f) tag[f] = mRes.salientFaces[f] ? 0u : uint32_t(f + 1);  // non-salient: unique
+        labelComponents(mGraph, tag, comp);
         std::map<uint32_t, uint32_t> renumber;
-        for (size_t f = 0; f < faceCount; ++f)
-            if (res.salientFaces[f]) {
-                auto it = renumber.emplace(comp[f], uint32_t(renumber.size())).first;
-                salientRegionOf[f] = it->second;
-            }
-        res.salientRegions = renumber.size();
-    }
+        for (size_t f = 0; f < mFaceCount; ++f)
+            if (mRes.salientFaces[f]) mSalientRegionOf[f] = renumber.emplace(comp[f], uint32_t(renumber.size())).first->second;
+        mRes.salientRegions = renumber.size();
+        mSalientFacesOf.assign(mRes.salientRegions, {});
+        for (uint32_t f = 0; f < mFaceCount; ++f)
+            if (mSalientRegionOf[f] != kNone) mSalientFacesOf[mSalientRegionOf[f]].push_back(f);
 
-    // Data term, Eq. (2): D(t, n) = log d(t, n), d in units of b0, clamped below.
-    const NearestBalls near = nearestBalls(graph.centroidsMm, ballMm, opt.candidateCount, 2.0 * b0);
-    const int k = near.k;
-    auto dataCost = [&](double dMm) { return opt.dataWeight * std::log(std::max(dMm / b0, opt.minDistanceB0)); };
-    res.nearestLabels.resize(faceCount);
-    for (size_t f = 0; f < faceCount; ++f) res.nearestLabels[f] = near.labels[f * size_t(k)];
-    {
+        mNear = nearestBalls(mGraph.centroidsMm, mBallMm, mOpt.candidateCount, mB0);
+        mK = mNear.k;
+        mRes.nearestLabels.resize(mFaceCount);
+        for (size_t f = 0; f < mFaceCount; ++f) mRes.nearestLabels[f] = mNear.labels[f * size_t(mK)];
+        {
+            std::vector<uint32_t> comp2;
+            mRes.nearestPartitions = labelComponents(mGraph, mRes.nearestLabels, comp2);
+        }
         // A frame made for another mesh (or another scale) leaves the surface far from every ball.
-        std::vector<double> d(faceCount);
-        for (size_t f = 0; f < faceCount; ++f) d[f] = near.distancesMm[f * size_t(k)];
-        std::nth_element(d.begin(), d.begin() + long(faceCount / 2), d.end());
-        const double median = d[faceCount / 2];
-        if (median > 5.0 * b0)
+        std::vector<double> d(mFaceCount);
+        for (size_t f = 0; f < mFaceCount; ++f) d[f] = mNear.distancesMm[f * size_t(mK)];
+        std::nth_element(d.begin(), d.begin() + long(mFaceCount / 2), d.end());
+        const double median = d[mFaceCount / 2];
+        if (median > 5.0 * mB0)
             throw Error(ErrorCode::InvalidInput,
                         fmt("frame and mesh do not match: the surface lies a median %.0f mm (%.1f b0) from the "
                             "nearest outermost ball (check transform_mm)",
-                            median, median / b0));
-    }
-    run.throwIfCancelled();
+                            median, median / mB0));
 
-    // Graph-cut nodes: faces, or clusters of faces on large meshes.
-    const size_t clusterSize = (opt.graphNodeTarget > 0 && faceCount > opt.graphNodeTarget)
-                                   ? (faceCount + opt.graphNodeTarget - 1) / opt.graphNodeTarget
-                                   : 1;
-    const Units units = buildUnits(graph, res.salientFaces, clusterSize);
-    if (clusterSize > 1)
-        run.debug("graph cut on " + std::to_string(units.count()) + " clusters of up to " + std::to_string(clusterSize) +
-                  " faces");
-    auto makeProblem = [&](const Units& units, std::vector<uint32_t>& initialUnitLabels) {
+        mFaceEdgeWeights.resize(mGraph.neighbors.size());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, mFaceCount, 4096), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t f = r.begin(); f < r.end(); ++f)
+                for (uint32_t i = mGraph.offsets[f]; i < mGraph.offsets[f + 1]; ++i)
+                    mFaceEdgeWeights[i] = edgeWeight(mGraph, mRes.salientFaces, uint32_t(f), mGraph.neighbors[i], mOpt);
+        });
+    }
+
+    /// Data term, Eq. (2): D(t, n) = w_data · log d(t, n), d in units of b0, clamped below.
+    double dataCost(double dMm) const { return mOpt.dataWeight * std::log(std::max(dMm / mB0, mOpt.minDistanceB0)); }
+
+    /// D summed over the faces of node @p u of @p units, with the true distances.
+    double unitCost(const Units& units, size_t u, uint32_t label) const {
+        double sum = 0.0;
+        for (uint32_t j = units.offsets[u]; j < units.offsets[u + 1]; ++j)
+            sum += dataCost(std::sqrt(dist2(mGraph.centroidsMm[units.faces[j]], mBallMm[label])));
+        return sum;
+    }
+
+    // --- graph-cut problems (docs/partition.md §3, "Graph size") --------------------------------
+
+    /// Graph-cut nodes: faces (salient regions contracted), or on very large meshes small clusters
+    /// of faces; with two levels, also large clusters solved first.
+    void prepareProblems() {
+        auto sizeFor = [&](size_t target) {
+            return (target > 0 && mFaceCount > target) ? (mFaceCount + target - 1) / target : size_t(1);
+        };
+        const size_t nodeSize = sizeFor(mOpt.refineNodeTarget);
+        const size_t clusterSize = std::max(nodeSize, sizeFor(mOpt.graphNodeTarget));
+        mIsTwoLevel = clusterSize > nodeSize;
+        mUnits = buildUnits(mGraph, mRes.salientFaces, nodeSize);
+        mProb = makeProblem(mUnits, mInitial);
+        if (mIsTwoLevel) {
+            mClusters = buildUnits(mGraph, mRes.salientFaces, clusterSize);
+            mClusterProb = makeProblem(mClusters, mClusterInitial);
+        }
+        // Band of the refinement: about a large cluster's diameter in rings of faces, at least 3.
+        mBandRings = std::max(3, int(std::ceil(std::sqrt(double(clusterSize)))));
+        if (mIsTwoLevel)
+            mRun.debug("graph cut on " + std::to_string(mClusters.count()) + " clusters of up to " +
+                       std::to_string(clusterSize) + " faces, then on the " + std::to_string(mUnits.count()) +
+                       "-node graph within " + std::to_string(mBandRings) + " rings of their seams");
+        mRes.graphNodes = mIsTwoLevel ? mClusters.count() : mUnits.count();
+        mRes.candidatePairs = mIsTwoLevel ? mClusterProb.candidateLabels.size() : mProb.candidateLabels.size();
+        mRes.refineNodes = mUnits.count();
+    }
+
+    /// The labelling problem over @p units; @p initial receives each node's cheapest candidate
+    /// (the nearest ball, summed over a node's faces).
+    LabelingProblem makeProblem(const Units& units, std::vector<uint32_t>& initial) const {
         const size_t unitCount = units.count();
+        const int k = mK;
         LabelingProblem prob;
-        prob.labelCount = labelCount;
-        prob.candidateOffsets.assign(1, 0);
-        initialUnitLabels.resize(unitCount);
-        std::vector<std::vector<std::pair<uint32_t, double>>> perUnit(unitCount);
+        prob.labelCount = mLabelCount;
+        initial.resize(unitCount);
+        // Singletons take their face's k nearest directly; a cluster or salient region takes the
+        // union of its faces' candidates, each cost the sum over its faces with the true distances.
+        std::vector<std::vector<std::pair<uint32_t, double>>> multi(unitCount);  // only multi-face units
+        std::vector<uint32_t> counts(unitCount);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, unitCount, 256), [&](const tbb::blocked_range<size_t>& r) {
+            std::vector<char> isSeen(mLabelCount, 0);
+            std::vector<uint32_t> labels;
             for (size_t u = r.begin(); u < r.end(); ++u) {
-                auto& cand = perUnit[u];
                 const uint32_t b = units.offsets[u], e = units.offsets[u + 1];
                 if (e - b == 1) {
-                    const uint32_t f = units.faces[b];
-                    for (int i = 0; i < k; ++i)
-                        cand.push_back({near.labels[f * size_t(k) + size_t(i)], dataCost(near.distancesMm[f * size_t(k) + size_t(i)])});
-                } else {
-                    // A cluster or salient region: the union of its faces' candidates, each cost
-                    // the sum over its faces with the true distances.
-                    std::vector<uint32_t> labels;
-                    for (uint32_t j = b; j < e; ++j)
-                        for (int i = 0; i < k; ++i) labels.push_back(near.labels[units.faces[j] * size_t(k) + size_t(i)]);
-                    std::sort(labels.begin(), labels.end());
-                    labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
-                    for (uint32_t l : labels) {
-                        double sum = 0.0;
-                        for (uint32_t j = b; j < e; ++j)
-                            sum += dataCost(std::sqrt(dist2(graph.centroidsMm[units.faces[j]], ballMm[l])));
-                        cand.push_back({l, sum});
+                    counts[u] = uint32_t(k);
+                    continue;
+                }
+                labels.clear();
+                for (uint32_t j = b; j < e; ++j)
+                    for (int i = 0; i < k; ++i) {
+                        const uint32_t l = mNear.labels[units.faces[j] * size_t(k) + size_t(i)];
+                        if (!isSeen[l]) isSeen[l] = 1, labels.push_back(l);
                     }
+                for (uint32_t l : labels) isSeen[l] = 0;
+                std::sort(labels.begin(), labels.end());
+                for (uint32_t l : labels) multi[u].push_back({l, unitCost(units, u, l)});
+                counts[u] = uint32_t(labels.size());
+            }
+        });
+        prob.candidateOffsets.assign(unitCount + 1, 0);
+        for (size_t u = 0; u < unitCount; ++u) prob.candidateOffsets[u + 1] = prob.candidateOffsets[u] + counts[u];
+        prob.candidateLabels.resize(prob.candidateOffsets.back());
+        prob.candidateCosts.resize(prob.candidateOffsets.back());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, unitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t u = r.begin(); u < r.end(); ++u) {
+                uint32_t slot = prob.candidateOffsets[u];
+                double bestCost = 1e300;
+                uint32_t bestLabel = 0;
+                auto put = [&](uint32_t l, double c) {
+                    prob.candidateLabels[slot] = l;
+                    prob.candidateCosts[slot++] = c;
+                    if (c < bestCost || (c == bestCost && l < bestLabel)) bestCost = c, bestLabel = l;
+                };
+                if (units.offsets[u + 1] - units.offsets[u] == 1) {
+                    const size_t f = units.faces[units.offsets[u]];
+                    for (int i = 0; i < k; ++i)
+                        put(mNear.labels[f * size_t(k) + size_t(i)], dataCost(mNear.distancesMm[f * size_t(k) + size_t(i)]));
+                } else {
+                    for (const auto& [l, c] : multi[u]) put(l, c);
+                }
+                initial[u] = bestLabel;
+            }
+        });
+        // Smoothness weights between nodes: the sum of Eq. (3) over the face pairs they share.
+        // Per node, its (neighbour, weight) entries sorted by (neighbour, weight) and summed in that
+        // order, so W_uv and W_vu are the same sum bit for bit (and independent of threads).
+        auto gather = [&](size_t u, std::vector<std::pair<uint32_t, double>>& list) {
+            list.clear();
+            for (uint32_t j = units.offsets[u]; j < units.offsets[u + 1]; ++j) {
+                const uint32_t f = units.faces[j];
+                for (uint32_t i = mGraph.offsets[f]; i < mGraph.offsets[f + 1]; ++i) {
+                    const uint32_t v = units.unitOf[mGraph.neighbors[i]];
+                    if (v != u) list.push_back({v, mFaceEdgeWeights[i]});
+                }
+            }
+            std::sort(list.begin(), list.end());
+        };
+        std::vector<uint32_t> neighborCounts(unitCount, 0);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, unitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
+            std::vector<std::pair<uint32_t, double>> list;
+            for (size_t u = r.begin(); u < r.end(); ++u) {
+                gather(u, list);
+                uint32_t n = 0;
+                for (size_t i = 0; i < list.size(); ++i) n += (i == 0 || list[i].first != list[i - 1].first) ? 1 : 0;
+                neighborCounts[u] = n;
+            }
+        });
+        prob.neighborOffsets.assign(unitCount + 1, 0);
+        for (size_t u = 0; u < unitCount; ++u) prob.neighborOffsets[u + 1] = prob.neighborOffsets[u] + neighborCounts[u];
+        prob.neighbors.resize(prob.neighborOffsets.back());
+        prob.neighborWeights.resize(prob.neighborOffsets.back());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, unitCount, 1024), [&](const tbb::blocked_range<size_t>& r) {
+            std::vector<std::pair<uint32_t, double>> list;
+            for (size_t u = r.begin(); u < r.end(); ++u) {
+                gather(u, list);
+                uint32_t slot = prob.neighborOffsets[u];
+                for (size_t i = 0; i < list.size();) {
+                    double w = 0.0;
+                    size_t j = i;
+                    while (j < list.size() && list[j].first == list[i].first) w += list[j++].second;
+                    prob.neighbors[slot] = list[i].first;
+                    prob.neighborWeights[slot++] = w;
+                    i = j;
                 }
             }
         });
-        for (size_t u = 0; u < unitCount; ++u) {
-            double bestCost = 1e300;
-            uint32_t bestLabel = 0;
-            for (const auto& [l, c] : perUnit[u]) {
-                prob.candidateLabels.push_back(l);
-                prob.candidateCosts.push_back(c);
-                if (c < bestCost || (c == bestCost && l < bestLabel)) bestCost = c, bestLabel = l;
-            }
-            prob.candidateOffsets.push_back(uint32_t(prob.candidateLabels.size()));
-            initialUnitLabels[u] = bestLabel;  // the nearest ball (summed over a node's faces)
-        }
-        // Smoothness weights between nodes: the sum of Eq. (3) over the face pairs they share.
-        std::vector<std::tuple<uint32_t, uint32_t, double>> pairs;
-        pairs.reserve(graph.neighbors.size());
-        for (uint32_t f = 0; f < faceCount; ++f)
-            for (uint32_t i = graph.offsets[f]; i < graph.offsets[f + 1]; ++i) {
-                const uint32_t h = graph.neighbors[i];
-                const uint32_t u = units.unitOf[f], v = units.unitOf[h];
-                if (u == v) continue;
-                pairs.emplace_back(u, v, edgeWeight(graph, res.salientFaces, f, h, opt));
-            }
-        tbb::parallel_sort(pairs.begin(), pairs.end());  // total order: deterministic sums
-        prob.neighborOffsets.assign(unitCount + 1, 0);
-        for (size_t i = 0; i < pairs.size();) {
-            size_t j = i;
-            double w = 0.0;
-            while (j < pairs.size() && std::get<0>(pairs[j]) == std::get<0>(pairs[i]) &&
-                   std::get<1>(pairs[j]) == std::get<1>(pairs[i]))
-                w += std::get<2>(pairs[j++]);
-            prob.neighbors.push_back(std::get<1>(pairs[i]));
-            prob.neighborWeights.push_back(w);
-            ++prob.neighborOffsets[std::get<0>(pairs[i]) + 1];
-            i = j;
-        }
-        for (size_t u = 0; u < unitCount; ++u) prob.neighborOffsets[u + 1] += prob.neighborOffsets[u];
         return prob;
-    };
-    std::vector<uint32_t> initialLabels;
-    const LabelingProblem prob = makeProblem(units, initialLabels);
-    res.graphNodes = units.count();
-    res.candidatePairs = prob.candidateLabels.size();
-    run.throwIfCancelled();
+    }
 
-    // --- fit schedule: w_smoothness = 10, ×0.1 while a partition does not fit (§5.1) ---------
-    Context cx{meshMm, graph, opt, run, std::vector<uint32_t>(meshMm.positions.size(), 0), 0};
-    auto toFaces = [&](const std::vector<uint32_t>& unitLabels) {
-        std::vector<uint32_t> f(faceCount);
-        for (size_t i = 0; i < faceCount; ++i) f[i] = unitLabels[units.unitOf[i]];
-        return f;
-    };
-    const Stopwatch cutClock;
-    double ws = opt.smoothnessStart;
-    std::vector<std::vector<uint32_t>> oversized;
-    for (int step = 0;; ++step) {
-        const Stopwatch stepClock;
+    /// The node-level problem with every node outside @p band held at its label in @p labels (its
+    /// only candidate) and every node inside also allowed its current label: the same energy as
+    /// mProb for labellings that agree outside the band, and expansions only touch the band.
+    LabelingProblem restrictToBand(const std::vector<uint32_t>& labels, const std::vector<char>& band) const {
+        LabelingProblem r;
+        r.labelCount = mLabelCount;
+        r.candidateLabels.reserve(mProb.candidateLabels.size());
+        r.candidateCosts.reserve(mProb.candidateCosts.size());
+        auto costOf = [&](size_t u, uint32_t l) {
+            const int64_t s = mProb.slotOf(uint32_t(u), l);
+            return s >= 0 ? mProb.candidateCosts[size_t(s)] : unitCost(mUnits, u, l);
+        };
+        for (size_t u = 0; u < mUnits.count(); ++u) {
+            if (band[u]) {
+                for (uint32_t s = mProb.candidateOffsets[u]; s < mProb.candidateOffsets[u + 1]; ++s) {
+                    r.candidateLabels.push_back(mProb.candidateLabels[s]);
+                    r.candidateCosts.push_back(mProb.candidateCosts[s]);
+                }
+                if (mProb.slotOf(uint32_t(u), labels[u]) < 0) {
+                    r.candidateLabels.push_back(labels[u]);
+                    r.candidateCosts.push_back(costOf(u, labels[u]));
+                }
+            } else {
+                r.candidateLabels.push_back(labels[u]);
+                r.candidateCosts.push_back(costOf(u, labels[u]));
+            }
+            r.candidateOffsets.push_back(uint32_t(r.candidateLabels.size()));
+        }
+        r.neighborOffsets = mProb.neighborOffsets;
+        r.neighbors = mProb.neighbors;
+        r.neighborWeights = mProb.neighborWeights;
+        return r;
+    }
+
+    /// Nodes within mBandRings rings of faces of a seam of @p labels.
+    std::vector<char> seamBand(const std::vector<uint32_t>& labels) const {
+        std::vector<int> ring(mFaceCount, -1);
+        std::vector<uint32_t> frontier, next;
+        for (uint32_t f = 0; f < mFaceCount; ++f)
+            for (uint32_t i = mGraph.offsets[f]; i < mGraph.offsets[f + 1]; ++i)
+                if (labels[mUnits.unitOf[mGraph.neighbors[i]]] != labels[mUnits.unitOf[f]]) {
+                    ring[f] = 0;
+                    frontier.push_back(f);
+                    break;
+                }
+        for (int r = 1; r <= mBandRings && !frontier.empty(); ++r) {
+            next.clear();
+            for (uint32_t f : frontier)
+                for (uint32_t i = mGraph.offsets[f]; i < mGraph.offsets[f + 1]; ++i) {
+                    const uint32_t h = mGraph.neighbors[i];
+                    if (ring[h] < 0) ring[h] = r, next.push_back(h);
+                }
+            frontier.swap(next);
+        }
+        std::vector<char> band(mUnits.count(), 0);
+        for (uint32_t f = 0; f < mFaceCount; ++f)
+            if (ring[f] >= 0) band[mUnits.unitOf[f]] = 1;
+        return band;
+    }
+
+    /// One graph cut at w_smoothness @p ws from the nearest-ball labelling (two levels when set).
+    AlphaExpansionResult graphCut(double ws, ScheduleStep& st) const {
         AlphaExpansionOptions ao;
         ao.smoothnessWeight = ws;
-        ao.maxSweeps = opt.maxSweeps;
-        ScheduleStep st;
-        st.smoothnessWeight = ws;
-        AlphaExpansionResult ae = alphaExpansion(prob, initialLabels, ao, run);
-        st.energyNearest = ae.sweepEnergies.front();
-        st.energyGraphCut = ae.sweepEnergies.back();
-        st.sweeps = ae.sweeps;
-        st.expansions = ae.expansions;
-        res.graphCutLabels = toFaces(ae.labels);
-        oversized = oversizedRegions(cx, res.graphCutLabels, &st.partitions);
-        st.oversized = oversized.size();
-        st.seconds = stepClock.seconds();
-        res.schedule.push_back(st);
-        res.smoothnessWeight = ws;
-        res.energyNearest = st.energyNearest;
-        res.energyGraphCut = st.energyGraphCut;
-        res.sweepEnergies = ae.sweepEnergies;
-        res.graphCutPartitions = st.partitions;
-        run.info(fmt("w_smoothness %g: E %.6g -> %.6g, %.0f partitions", ws, st.energyNearest, st.energyGraphCut,
-                     double(st.partitions)) +
-                 (oversized.empty() ? ", all fit the printer" : ", " + std::to_string(oversized.size()) + " too large"));
-        if (!ae.isConverged) run.warn(fmt("graph cut at w_smoothness %g stopped after %.0f sweeps before converging", ws, double(ae.sweeps)));
-        run.progress("partition", std::min(0.6, 0.1 * (step + 1)));
-        if (oversized.empty()) break;
-        if (ws * opt.smoothnessFactor < opt.smoothnessMin * (1.0 - 1e-9) || ws == 0.0) {
-            res.isScheduleBottomedOut = true;
-            break;
-        }
-        ws *= opt.smoothnessFactor;
-    }
-    res.secondsGraphCut = cutClock.seconds();
-    {
-        std::vector<uint32_t> comp;
-        res.nearestPartitions = labelComponents(graph, res.nearestLabels, comp);
+        ao.maxSweeps = mOpt.maxSweeps;
+        st.energyNearest = labelingEnergy(mProb, mInitial, ws);
+        if (!mIsTwoLevel) return alphaExpansion(mProb, mInitial, ao, mRun);
+        // Clusters from their nearest balls, then the nodes near the cluster seams from there.
+        const AlphaExpansionResult coarse = alphaExpansion(mClusterProb, mClusterInitial, ao, mRun);
+        std::vector<uint32_t> projected(mUnits.count());
+        for (size_t u = 0; u < mUnits.count(); ++u)
+            projected[u] = coarse.labels[mClusters.unitOf[mUnits.faces[mUnits.offsets[u]]]];
+        const std::vector<char> band = seamBand(projected);
+        st.clusterSweeps = coarse.sweeps;
+        st.clusterExpansions = coarse.expansions;
+        st.energyClusters = coarse.sweepEnergies.back();
+        st.bandNodes = size_t(std::count(band.begin(), band.end(), char(1)));
+        return alphaExpansion(restrictToBand(projected, band), projected, ao, mRun);
     }
 
-    // Training classes: the graph-cut labels, plus new classes for split parts.
-    std::vector<uint32_t> trainClass = res.graphCutLabels;
-    std::vector<zome::BallId> classBall(labelBalls.begin(), labelBalls.end());
-    auto newClassFor = [&](const std::vector<uint32_t>& faces) {
-        // The ball most of these faces are nearest to (lowest label on ties).
+    // --- fit schedule (§5.1) ---------------------------------------------------------------------
+
+    /// w_smoothness = 10, ×0.1 while a partition does not fit; split when it bottoms out.
+    void runSchedule() {
+        const Stopwatch clock;
+        Context& cx = context();
+        double ws = mOpt.smoothnessStart;
+        std::vector<std::vector<uint32_t>> oversized;
+        for (int step = 0;; ++step) {
+            const Stopwatch stepClock;
+            ScheduleStep st;
+            st.smoothnessWeight = ws;
+            const AlphaExpansionResult ae = graphCut(ws, st);
+            st.energyGraphCut = ae.sweepEnergies.back();
+            st.sweeps = ae.sweeps;
+            st.expansions = ae.expansions;
+            mRes.graphCutLabels.resize(mFaceCount);
+            for (size_t f = 0; f < mFaceCount; ++f) mRes.graphCutLabels[f] = ae.labels[mUnits.unitOf[f]];
+            oversized = oversizedRegions(cx, mRes.graphCutLabels, &st.partitions);
+            st.oversized = oversized.size();
+            st.seconds = stepClock.seconds();
+            mRes.schedule.push_back(st);
+            mRes.smoothnessWeight = ws;
+            mRes.energyNearest = st.energyNearest;
+            mRes.energyGraphCut = st.energyGraphCut;
+            mRes.sweepEnergies = ae.sweepEnergies;
+            mRes.graphCutPartitions = st.partitions;
+            mRun.info(fmt("w_smoothness %g: E %.6g -> %.6g, %.0f partitions", ws, st.energyNearest, st.energyGraphCut,
+                          double(st.partitions)) +
+                      (oversized.empty() ? ", all fit the printer" : ", " + std::to_string(oversized.size()) + " too large"));
+            if (!ae.isConverged)
+                mRun.warn(fmt("graph cut at w_smoothness %g stopped after %.0f sweeps before converging", ws, double(ae.sweeps)));
+            mRun.progress("partition", std::min(0.6, 0.1 * (step + 1)));
+            if (oversized.empty()) break;
+            if (ws * mOpt.smoothnessFactor < mOpt.smoothnessMin * (1.0 - 1e-9) || ws == 0.0) {
+                mRes.isScheduleBottomedOut = true;
+                break;
+            }
+            ws *= mOpt.smoothnessFactor;
+        }
+        mRes.secondsGraphCut = clock.seconds();
+
+        // Training classes: the graph-cut labels, plus new classes for split parts.
+        mTrainClass = mRes.graphCutLabels;
+        mClassBall.assign(mLabelBalls.begin(), mLabelBalls.end());
+        if (mRes.isScheduleBottomedOut) {
+            for (const auto& region : oversized) mRes.splits += splitFaces(region) ? 1 : 0;
+            mRun.warn(fmt("the fit schedule bottomed out at w_smoothness %g with %.0f partitions larger than the "
+                          "printer; split them",
+                          ws, double(oversized.size())));
+        }
+    }
+
+    Context& context() {
+        if (!mContext)
+            mContext = std::make_unique<Context>(
+                Context{mMesh, mGraph, mOpt, mRun, std::vector<uint32_t>(mMesh.positions.size(), 0), 0});
+        return *mContext;
+    }
+
+    /// A new training class for @p faces, attached to the ball most of them are nearest to
+    /// (lowest label on ties).
+    uint32_t newClassFor(const std::vector<uint32_t>& faces) {
         std::map<uint32_t, size_t> votes;
-        for (uint32_t f : faces) ++votes[res.nearestLabels[f]];
+        for (uint32_t f : faces) ++votes[mRes.nearestLabels[f]];
         uint32_t best = votes.begin()->first;
         for (const auto& [l, n] : votes)
             if (n > votes[best]) best = l;
-        classBall.push_back(labelBalls[best]);
-        return uint32_t(classBall.size() - 1);
-    };
-    auto splitFaces = [&](const std::vector<uint32_t>& faces) {
-        std::vector<std::vector<uint32_t>> parts;
-        bisectUntilFit(cx, faces, salientRegionOf, parts, 0);
-        for (size_t p = 1; p < parts.size(); ++p) {  // the first part keeps its class
-            const uint32_t c = newClassFor(parts[p]);
-            for (uint32_t f : parts[p]) trainClass[f] = c;
-        }
-        return parts.size() > 1;
-    };
-    if (res.isScheduleBottomedOut) {
-        size_t count = 0;
-        for (const auto& region : oversized) count += splitFaces(region) ? 1 : 0;
-        res.splits += count;
-        run.warn(fmt("the fit schedule bottomed out at w_smoothness %g with %.0f partitions larger than the printer; "
-                     "split them",
-                     ws, double(oversized.size())));
+        mClassBall.push_back(mLabelBalls[best]);
+        return uint32_t(mClassBall.size() - 1);
     }
 
-    // --- planar cuts (§5.2) and pieces, repaired until every piece fits ------------------------
-    const Stopwatch svmClock;
-    std::vector<std::vector<uint32_t>> salientFacesOf(res.salientRegions);
-    for (uint32_t f = 0; f < faceCount; ++f)
-        if (salientRegionOf[f] != kNone) salientFacesOf[salientRegionOf[f]].push_back(f);
+    /// Bisects @p faces until the parts fit; every part but the first gets a new class.
+    bool splitFaces(const std::vector<uint32_t>& faces) {
+        std::vector<std::vector<uint32_t>> parts;
+        bisectUntilFit(context(), faces, mSalientRegionOf, parts, 0);
+        for (size_t p = 1; p < parts.size(); ++p) {
+            const uint32_t c = newClassFor(parts[p]);
+            for (uint32_t f : parts[p]) mTrainClass[f] = c;
+        }
+        return parts.size() > 1;
+    }
 
-    for (int round = 0;; ++round) {
-        run.throwIfCancelled();
-        // Samples: face centroids. On large meshes, at most half the budget goes to the faces
-        // within two rings of a class boundary (where the planes are decided) and the rest to the
-        // other faces, each set thinned evenly in face order.
-        std::vector<char> keep(faceCount, 1);
-        if (faceCount > opt.svmMaxSamples) {
-            std::vector<char> band(faceCount, 0);
-            for (uint32_t f = 0; f < faceCount; ++f)
-                for (uint32_t i = graph.offsets[f]; i < graph.offsets[f + 1]; ++i)
-                    if (trainClass[graph.neighbors[i]] != trainClass[f]) band[f] = 1;
+    // --- planar cuts (§5.2) and pieces ------------------------------------------------------------
+
+    /// Training samples: face centroids. On large meshes, at most half the budget goes to the
+    /// faces within two rings of a class boundary (where the planes are decided) and the rest to
+    /// the other faces, each set thinned evenly in face order.
+    void trainingSamples(std::vector<Vec3d>& samples, std::vector<uint32_t>& classes) const {
+        std::vector<char> keep(mFaceCount, 1);
+        if (mFaceCount > mOpt.svmMaxSamples) {
+            std::vector<char> band(mFaceCount, 0);
+            for (uint32_t f = 0; f < mFaceCount; ++f)
+                for (uint32_t i = mGraph.offsets[f]; i < mGraph.offsets[f + 1]; ++i)
+                    if (mTrainClass[mGraph.neighbors[i]] != mTrainClass[f]) band[f] = 1;
             std::vector<char> band2(band);
-            for (uint32_t f = 0; f < faceCount; ++f)
+            for (uint32_t f = 0; f < mFaceCount; ++f)
                 if (band[f])
-                    for (uint32_t i = graph.offsets[f]; i < graph.offsets[f + 1]; ++i) band2[graph.neighbors[i]] = 1;
-            size_t bandCount = 0;
-            for (char b : band2) bandCount += b ? 1 : 0;
-            const size_t restCount = faceCount - bandCount;
-            const size_t bandBudget = std::min(bandCount, opt.svmMaxSamples / 2);
-            const size_t restBudget = std::max<size_t>(1, opt.svmMaxSamples - bandBudget);
+                    for (uint32_t i = mGraph.offsets[f]; i < mGraph.offsets[f + 1]; ++i) band2[mGraph.neighbors[i]] = 1;
+            const size_t bandCount = size_t(std::count(band2.begin(), band2.end(), char(1)));
+            const size_t restCount = mFaceCount - bandCount;
+            const size_t bandBudget = std::min(bandCount, mOpt.svmMaxSamples / 2);
+            const size_t restBudget = std::max<size_t>(1, mOpt.svmMaxSamples - bandBudget);
             auto strideFor = [](size_t count, size_t budget) {
                 return budget == 0 ? count + 1 : std::max<size_t>(1, (count + budget - 1) / budget);
             };
             const size_t bandStride = strideFor(bandCount, bandBudget), restStride = strideFor(restCount, restBudget);
             size_t bi = 0, ri = 0;
-            for (uint32_t f = 0; f < faceCount; ++f)
+            for (uint32_t f = 0; f < mFaceCount; ++f)
                 keep[f] = band2[f] ? ((bi++ % bandStride) == 0) : ((ri++ % restStride) == 0);
         }
-        std::vector<Vec3d> samples;
-        std::vector<uint32_t> sampleClass;
-        for (uint32_t f = 0; f < faceCount; ++f)
-            if (keep[f]) samples.push_back(graph.centroidsMm[f]), sampleClass.push_back(trainClass[f]);
-        const size_t baseSamples = samples.size();
+        samples.clear();
+        classes.clear();
+        for (uint32_t f = 0; f < mFaceCount; ++f)
+            if (keep[f]) samples.push_back(mGraph.centroidsMm[f]), classes.push_back(mTrainClass[f]);
+    }
 
-        CellTrainingOptions so = opt.svm;
-        so.seed = opt.seed;
-        LinearCells cells = trainLinearCells(samples, sampleClass, so);
-        auto computeFaceCells = [&](const LinearCells& c) {
-            std::vector<uint32_t> fc(faceCount);
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, faceCount, 4096), [&](const tbb::blocked_range<size_t>& r) {
-                for (size_t f = r.begin(); f < r.end(); ++f) fc[f] = c.cellAt(graph.centroidsMm[f]);
-            });
-            return fc;
-        };
-        // A salient region is crossed when its faces' corners do not all lie in one cell.
-        auto crossedRegions = [&](const LinearCells& c) {
-            std::vector<uint32_t> crossed;
-            for (uint32_t r = 0; r < res.salientRegions; ++r) {
-                uint32_t first = kNone;
-                bool isCrossed = false;
-                for (uint32_t f : salientFacesOf[r]) {
-                    for (uint32_t v : meshMm.triangles[f]) {
-                        const uint32_t cell = c.cellAt(toD(meshMm.positions[v]));
-                        if (first == kNone) first = cell;
-                        if (cell != first) isCrossed = true;
-                    }
-                    if (isCrossed) break;
+    /// The salient regions some of whose corners lie in another cell than the others.
+    std::vector<uint32_t> crossedRegions(const LinearCells& cells) const {
+        std::vector<uint32_t> crossed;
+        for (uint32_t r = 0; r < mRes.salientRegions; ++r) {
+            uint32_t first = kNone;
+            bool isCrossed = false;
+            for (uint32_t f : mSalientFacesOf[r]) {
+                for (uint32_t v : mMesh.triangles[f]) {
+                    const uint32_t cell = cells.cellAt(toD(mMesh.positions[v]));
+                    if (first == kNone) first = cell;
+                    if (cell != first) isCrossed = true;
                 }
-                if (isCrossed) crossed.push_back(r);
+                if (isCrossed) break;
             }
-            return crossed;
-        };
-        std::vector<uint32_t> crossed = crossedRegions(cells);
-        for (int retry = 0; retry < opt.salientRetries && !crossed.empty(); ++retry) {
-            // Weight the crossed regions up: their corners as extra samples, repeated 4^retry times.
+            if (isCrossed) crossed.push_back(r);
+        }
+        return crossed;
+    }
+
+    /// Trains the cells; retrains with the corners of crossed salient regions weighted up.
+    LinearCells trainCells(std::vector<uint32_t>& crossed) {
+        std::vector<Vec3d> samples;
+        std::vector<uint32_t> classes;
+        trainingSamples(samples, classes);
+        CellTrainingOptions so = mOpt.svm;
+        so.seed = mOpt.seed;
+        LinearCells cells = trainLinearCells(samples, classes, so);
+        crossed = crossedRegions(cells);
+        for (int retry = 0; retry < mOpt.salientRetries && !crossed.empty(); ++retry) {
+            // Their corners as extra samples of their class, repeated 4^retry times.
             const int repeat = 1 << (2 * retry);
             for (uint32_t r : crossed)
-                for (uint32_t f : salientFacesOf[r])
-                    for (uint32_t v : meshMm.triangles[f])
+                for (uint32_t f : mSalientFacesOf[r])
+                    for (uint32_t v : mMesh.triangles[f])
                         for (int i = 0; i < repeat; ++i) {
-                            samples.push_back(toD(meshMm.positions[v]));
-                            sampleClass.push_back(trainClass[f]);
+                            samples.push_back(toD(mMesh.positions[v]));
+                            classes.push_back(mTrainClass[f]);
                         }
-            run.debug("retraining: " + std::to_string(crossed.size()) + " salient region(s) crossed by a cut");
-            cells = trainLinearCells(samples, sampleClass, so);
+            mRun.debug("retraining: " + std::to_string(crossed.size()) + " salient region(s) crossed by a cut");
+            cells = trainLinearCells(samples, classes, so);
             crossed = crossedRegions(cells);
         }
-        res.svmSamples = samples.size();
-        (void)baseSamples;
-        std::vector<uint32_t> faceCells = computeFaceCells(cells);
+        mRes.svmSamples = samples.size();
+        return cells;
+    }
 
-        // Fragments: connected faces of one cell. Each starts as a piece.
+    /// Pieces from the cells: fragments (connected faces of one cell), merged for crossed salient
+    /// regions and small areas when the result fits, numbered by lowest face, with their fits.
+    /// @p pieceFaces receives each piece's faces.
+    std::vector<Piece> makePieces(const LinearCells& cells, const std::vector<uint32_t>& faceCells,
+                                  const std::vector<uint32_t>& crossed, std::vector<uint32_t>& facePieces,
+                                  std::vector<std::vector<uint32_t>>& pieceFaces, size_t& merges) {
+        Context& cx = context();
         std::vector<uint32_t> fragOf;
-        const uint32_t fragCount = labelComponents(graph, faceCells, fragOf);
+        const uint32_t fragCount = labelComponents(mGraph, faceCells, fragOf);
         std::vector<uint32_t> fragOffsets, fragFaces;
         groupFaces(fragOf, fragCount, fragOffsets, fragFaces);
         std::vector<double> fragArea(fragCount, 0.0);
-        for (uint32_t f = 0; f < faceCount; ++f) fragArea[fragOf[f]] += graph.areasMm2[f];
+        for (uint32_t f = 0; f < mFaceCount; ++f) fragArea[fragOf[f]] += mGraph.areasMm2[f];
 
         Dsu dsu(fragCount);
         std::vector<std::vector<uint32_t>> members(fragCount);  // faces of each root
         for (uint32_t c = 0; c < fragCount; ++c)
             members[c].assign(fragFaces.begin() + fragOffsets[c], fragFaces.begin() + fragOffsets[c + 1]);
         std::vector<double> area(fragArea);
-        size_t merges = 0;
+        merges = 0;
         auto tryMerge = [&](uint32_t a, uint32_t b) {
             a = dsu.find(a), b = dsu.find(b);
             if (a == b) return true;
@@ -750,135 +929,185 @@ PartitionResult partitionSurface(const TriMesh& meshMm, const zome::Structure& f
             ++merges;
             return true;
         };
-        // Salient regions a cut still crosses: keep them in one piece by merging the fragments.
-        size_t stillSplit = 0;
+        // Salient regions a cut still crosses: keep them in one piece by merging the fragments of
+        // their faces and of the faces around them (where corners in another cell lie), if it fits.
         for (uint32_t r : crossed) {
-            bool isWhole = true;
-            const uint32_t first = fragOf[salientFacesOf[r].front()];
-            for (uint32_t f : salientFacesOf[r])
-                if (!tryMerge(first, fragOf[f])) isWhole = false;
-            // Faces in one piece, but the corners of some faces may still lie in another cell.
-            if (!isWhole) ++stillSplit;
-        }
-        // Small fragments into the neighbour they share the longest seam with.
-        {
-            std::vector<uint32_t> order(fragCount);
-            std::iota(order.begin(), order.end(), 0u);
-            std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-                return fragArea[a] != fragArea[b] ? fragArea[a] < fragArea[b] : a < b;
-            });
-            for (uint32_t c : order) {
-                const uint32_t root = dsu.find(c);
-                if (area[root] >= opt.minPieceAreaMm2) continue;
-                std::map<uint32_t, double> seam;  // neighbour root → shared edge length (mm)
-                for (uint32_t f : members[root])
-                    for (uint32_t i = graph.offsets[f]; i < graph.offsets[f + 1]; ++i) {
-                        const uint32_t h = graph.neighbors[i];
-                        const uint32_t other = dsu.find(fragOf[h]);
-                        if (other == root) continue;
-                        const auto& tf = meshMm.triangles[f];
-                        const auto& th = meshMm.triangles[h];
-                        std::vector<uint32_t> shared;
-                        for (uint32_t v : tf)
-                            if (v == th[0] || v == th[1] || v == th[2]) shared.push_back(v);
-                        if (shared.size() >= 2)
-                            seam[other] += std::sqrt(dist2(toD(meshMm.positions[shared[0]]), toD(meshMm.positions[shared[1]])));
-                    }
-                std::vector<std::pair<double, uint32_t>> byLength;
-                for (const auto& [o, len] : seam) byLength.push_back({-len, o});
-                std::sort(byLength.begin(), byLength.end());
-                for (const auto& [negLen, o] : byLength)
-                    if (tryMerge(root, o)) break;
+            const uint32_t first = fragOf[mSalientFacesOf[r].front()];
+            for (uint32_t f : mSalientFacesOf[r]) {
+                tryMerge(first, fragOf[f]);
+                for (uint32_t i = mGraph.offsets[f]; i < mGraph.offsets[f + 1]; ++i) tryMerge(first, fragOf[mGraph.neighbors[i]]);
             }
+        }
+        // Small fragments, smallest first, into the neighbour they share the longest seam with.
+        std::vector<uint32_t> order(fragCount);
+        std::iota(order.begin(), order.end(), 0u);
+        std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+            return fragArea[a] != fragArea[b] ? fragArea[a] < fragArea[b] : a < b;
+        });
+        for (uint32_t c : order) {
+            const uint32_t root = dsu.find(c);
+            if (area[root] >= mOpt.minPieceAreaMm2) continue;
+            std::map<uint32_t, double> seam;  // neighbour root → shared edge length (mm)
+            for (uint32_t f : members[root])
+                for (uint32_t i = mGraph.offsets[f]; i < mGraph.offsets[f + 1]; ++i) {
+                    const uint32_t h = mGraph.neighbors[i];
+                    const uint32_t other = dsu.find(fragOf[h]);
+                    if (other == root) continue;
+                    const auto& tf = mMesh.triangles[f];
+                    const auto& th = mMesh.triangles[h];
+                    std::vector<uint32_t> shared;
+                    for (uint32_t v : tf)
+                        if (v == th[0] || v == th[1] || v == th[2]) shared.push_back(v);
+                    if (shared.size() >= 2)
+                        seam[other] += std::sqrt(dist2(toD(mMesh.positions[shared[0]]), toD(mMesh.positions[shared[1]])));
+                }
+            std::vector<std::pair<double, uint32_t>> byLength;
+            for (const auto& [o, len] : seam) byLength.push_back({-len, o});
+            std::sort(byLength.begin(), byLength.end());
+            for (const auto& [negLen, o] : byLength)
+                if (tryMerge(root, o)) break;
         }
 
         // Pieces in order of their lowest face.
         std::vector<uint32_t> pieceOfRoot(fragCount, kNone);
-        std::vector<uint32_t> facePieces(faceCount);
+        facePieces.assign(mFaceCount, 0);
         uint32_t pieceCount = 0;
-        for (uint32_t f = 0; f < faceCount; ++f) {
+        for (uint32_t f = 0; f < mFaceCount; ++f) {
             const uint32_t root = dsu.find(fragOf[f]);
             if (pieceOfRoot[root] == kNone) pieceOfRoot[root] = pieceCount++;
             facePieces[f] = pieceOfRoot[root];
         }
-        std::vector<uint32_t> pieceOffsets, pieceFaces;
-        groupFaces(facePieces, pieceCount, pieceOffsets, pieceFaces);
+        pieceFaces.assign(pieceCount, {});
+        for (uint32_t f = 0; f < mFaceCount; ++f) pieceFaces[facePieces[f]].push_back(f);
         std::vector<Piece> pieces(pieceCount);
         std::vector<std::vector<Vec3d>> piecePts(pieceCount);
         for (uint32_t p = 0; p < pieceCount; ++p) {
             Piece& piece = pieces[p];
-            std::vector<uint32_t> faces(pieceFaces.begin() + pieceOffsets[p], pieceFaces.begin() + pieceOffsets[p + 1]);
-            piece.faceCount = uint32_t(faces.size());
-            for (uint32_t f : faces) {
-                piece.areaMm2 += graph.areasMm2[f];
+            piece.faceCount = uint32_t(pieceFaces[p].size());
+            for (uint32_t f : pieceFaces[p]) {
+                piece.areaMm2 += mGraph.areasMm2[f];
                 piece.cells.push_back(faceCells[f]);
             }
             std::sort(piece.cells.begin(), piece.cells.end());
             piece.cells.erase(std::unique(piece.cells.begin(), piece.cells.end()), piece.cells.end());
-            for (uint32_t c : piece.cells) piece.balls.push_back(classBall[cells.classes[c]]);
+            for (uint32_t c : piece.cells) piece.balls.push_back(mClassBall[cells.classes[c]]);
             std::sort(piece.balls.begin(), piece.balls.end());
             piece.balls.erase(std::unique(piece.balls.begin(), piece.balls.end()), piece.balls.end());
-            piecePts[p] = faceVertices(meshMm, faces, cx.stamp, cx.stampValue);
+            piecePts[p] = faceVertices(mMesh, pieceFaces[p], cx.stamp, cx.stampValue);
             for (const Vec3d& v : piecePts[p]) piece.boundsMm.expand(v);
         }
         tbb::parallel_for(uint32_t(0), pieceCount, [&](uint32_t p) {
-            pieces[p].fit = fitInPrinter(piecePts[p], opt.printerMm, opt.fitMarginMm);
+            pieces[p].fit = fitInPrinter(piecePts[p], mOpt.printerMm, mOpt.fitMarginMm);
         });
+        return pieces;
+    }
 
-        std::vector<uint32_t> tooLarge;
-        for (uint32_t p = 0; p < pieceCount; ++p)
-            if (!pieces[p].fit.fits) tooLarge.push_back(p);
-        if (tooLarge.empty() || round >= opt.maxRepairRounds) {
-            if (!tooLarge.empty()) {
-                const Piece& p = pieces[tooLarge.front()];
+    /// Salient regions whose faces lie in several pieces, or whose corners lie in a cell that is
+    /// not one of their piece's cells.
+    size_t countCrossedRegions(const std::vector<uint32_t>& crossed) const {
+        size_t count = 0;
+        for (uint32_t r : crossed) {
+            bool isSplit = false;
+            const uint32_t p0 = mRes.facePieces[mSalientFacesOf[r].front()];
+            const auto& cells = mRes.pieces[p0].cells;
+            for (uint32_t f : mSalientFacesOf[r]) {
+                if (mRes.facePieces[f] != p0) isSplit = true;
+                for (uint32_t v : mMesh.triangles[f])
+                    if (!std::binary_search(cells.begin(), cells.end(), mRes.cells.cellAt(toD(mMesh.positions[v]))))
+                        isSplit = true;
+            }
+            count += isSplit ? 1 : 0;
+        }
+        return count;
+    }
+
+    /// Cells, pieces, and split-and-retrain rounds until every piece fits.
+    void cutAndMakePieces() {
+        const Stopwatch clock;
+        for (int round = 0;; ++round) {
+            mRun.throwIfCancelled();
+            std::vector<uint32_t> crossed;
+            LinearCells cells = trainCells(crossed);
+            std::vector<uint32_t> faceCells(mFaceCount);
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, mFaceCount, 4096), [&](const tbb::blocked_range<size_t>& r) {
+                for (size_t f = r.begin(); f < r.end(); ++f) faceCells[f] = cells.cellAt(mGraph.centroidsMm[f]);
+            });
+            std::vector<uint32_t> facePieces;
+            std::vector<std::vector<uint32_t>> pieceFaces;
+            size_t merges = 0;
+            std::vector<Piece> pieces = makePieces(cells, faceCells, crossed, facePieces, pieceFaces, merges);
+
+            std::vector<uint32_t> tooLarge;
+            for (uint32_t p = 0; p < pieces.size(); ++p)
+                if (!pieces[p].fit.fits) tooLarge.push_back(p);
+            if (!tooLarge.empty() && round >= mOpt.maxRepairRounds)
                 throw Error(ErrorCode::ProcessingFailed,
                             std::to_string(tooLarge.size()) + " piece(s) still do not fit the printer " +
-                                sizeText(opt.printerMm) + " after " + std::to_string(round) + " repair rounds (piece " +
-                                std::to_string(tooLarge.front()) + " needs " + sizeText(p.fit.extentsMm) + ")");
+                                sizeText(mOpt.printerMm) + " after " + std::to_string(round) + " repair rounds (piece " +
+                                std::to_string(tooLarge.front()) + " needs " +
+                                sizeText(pieces[tooLarge.front()].fit.extentsMm) + ")");
+            if (tooLarge.empty()) {
+                size_t agree = 0;
+                for (uint32_t f = 0; f < mFaceCount; ++f) agree += cells.classes[faceCells[f]] == mTrainClass[f] ? 1 : 0;
+                mRes.svmAgreement = double(agree) / double(mFaceCount);
+                mRes.cells = std::move(cells);
+                mRes.cellBalls.clear();
+                for (uint32_t c : mRes.cells.classes) mRes.cellBalls.push_back(mClassBall[c]);
+                mRes.faceCells = std::move(faceCells);
+                mRes.facePieces = std::move(facePieces);
+                mRes.pieces = std::move(pieces);
+                mRes.merges = merges;
+                mRes.salientRegionsSplit = countCrossedRegions(crossed);
+                if (mRes.salientRegionsSplit > 0)
+                    mRun.warn(std::to_string(mRes.salientRegionsSplit) +
+                              " salient region(s) are crossed by a planar cut that could not be avoided");
+                break;
             }
-            size_t agree = 0;
-            for (uint32_t f = 0; f < faceCount; ++f) agree += cells.classes[faceCells[f]] == trainClass[f] ? 1 : 0;
-            res.svmAgreement = double(agree) / double(faceCount);
-            res.cells = std::move(cells);
-            res.cellBalls.clear();
-            for (uint32_t c : res.cells.classes) res.cellBalls.push_back(classBall[c]);
-            res.faceCells = std::move(faceCells);
-            res.facePieces = std::move(facePieces);
-            res.pieces = std::move(pieces);
-            res.merges = merges;
-            // Regions whose corners still lie in different cells of different pieces.
-            res.salientRegionsSplit = 0;
-            for (uint32_t r : crossed) {
-                bool isSplit = false;
-                const uint32_t p0 = res.facePieces[salientFacesOf[r].front()];
-                for (uint32_t f : salientFacesOf[r]) {
-                    if (res.facePieces[f] != p0) isSplit = true;
-                    for (uint32_t v : meshMm.triangles[f]) {
-                        const uint32_t c = res.cells.cellAt(toD(meshMm.positions[v]));
-                        if (!std::binary_search(res.pieces[p0].cells.begin(), res.pieces[p0].cells.end(), c)) isSplit = true;
-                    }
-                }
-                if (isSplit) ++res.salientRegionsSplit;
+            // Split the pieces that do not fit into new classes and train again.
+            for (uint32_t p : tooLarge) {
+                const uint32_t c = newClassFor(pieceFaces[p]);  // the piece's faces get one class of their own first
+                for (uint32_t f : pieceFaces[p]) mTrainClass[f] = c;
+                if (splitFaces(pieceFaces[p])) ++mRes.splits;
             }
-            if (res.salientRegionsSplit > 0)
-                run.warn(std::to_string(res.salientRegionsSplit) +
-                         " salient region(s) are crossed by a planar cut that could not be avoided");
-            (void)stillSplit;
-            break;
+            mRun.info(std::to_string(tooLarge.size()) +
+                      " piece(s) do not fit the printer after the planar cuts; split and retrain");
         }
-        // Split the pieces that do not fit into new classes and train again.
-        for (uint32_t p : tooLarge) {
-            std::vector<uint32_t> faces(pieceFaces.begin() + pieceOffsets[p], pieceFaces.begin() + pieceOffsets[p + 1]);
-            const uint32_t c = newClassFor(faces);  // the piece's faces get one class of their own first
-            for (uint32_t f : faces) trainClass[f] = c;
-            if (splitFaces(faces)) ++res.splits;
-        }
-        run.info(std::to_string(tooLarge.size()) + " piece(s) do not fit the printer after the planar cuts; split and retrain");
+        mRes.secondsSvm = clock.seconds();
     }
-    res.secondsSvm = svmClock.seconds();
-    res.secondsTotal = total.seconds();
-    run.progress("partition", 1.0);
-    return res;
+
+    const TriMesh& mMesh;
+    const zome::Structure& mFrame;
+    const std::vector<zome::BallId>& mLabelBalls;
+    const PartitionOptions& mOpt;
+    const RunContext& mRun;
+    const size_t mFaceCount;
+    const uint32_t mLabelCount;
+    const double mB0;
+
+    PartitionResult mRes;
+    std::vector<Vec3d> mBallMm;                 ///< label → ball centre, mm
+    FaceGraph mGraph;
+    std::vector<uint32_t> mSalientRegionOf;     ///< per face, kNone when not salient
+    std::vector<std::vector<uint32_t>> mSalientFacesOf;
+    NearestBalls mNear;
+    int mK = 0;                                 ///< candidates per face (k, at most the label count)
+    std::vector<double> mFaceEdgeWeights;       ///< Eq. (3) weights aligned with mGraph.neighbors
+    bool mIsTwoLevel = false;
+    int mBandRings = 3;
+    Units mUnits, mClusters;
+    LabelingProblem mProb, mClusterProb;
+    std::vector<uint32_t> mInitial, mClusterInitial;
+    std::vector<uint32_t> mTrainClass;          ///< per face: SVM class
+    std::vector<zome::BallId> mClassBall;       ///< class → ball
+    std::unique_ptr<Context> mContext;
+};
+
+}  // namespace
+
+PartitionResult partitionSurface(const TriMesh& meshMm, const zome::Structure& frame,
+                                 const std::vector<zome::BallId>& labelBalls, const PartitionOptions& options,
+                                 const RunContext& context) {
+    return Stage(meshMm, frame, labelBalls, options, context).run();
 }
 
 }  // namespace zomefab::partition

@@ -73,11 +73,14 @@ struct PartitionOptions {
     int maxRepairRounds = 8;  ///< split-and-retrain rounds for pieces that do not fit
 
     // --- graph size -------------------------------------------------------------------------
-    /// Above this many faces the graph cut runs on about this many clusters of edge-connected
-    /// faces (breadth-first from the lowest unassigned face, never across a salient boundary), so
-    /// its cost does not grow with the tessellation; 0 = every face is a node. The seams the SVM
-    /// learns from then follow cluster boundaries (a few mm on a 400 mm bunny).
-    size_t graphNodeTarget = 20000;
+    /// Above this many faces the graph cut first runs on about this many clusters of
+    /// edge-connected faces (breadth-first from the lowest unassigned face, never across a salient
+    /// boundary), starting from their nearest balls, then on the nodes within a band of rings
+    /// around the clusters' seams (the rest held). 0 = one level.
+    size_t graphNodeTarget = 5000;
+    /// The nodes of the refinement (and of a one-level cut): faces, or above this many faces about
+    /// this many small clusters, so the graph-cut cost stays flat on very fine meshes. 0 = faces.
+    size_t refineNodeTarget = 2000000;
 
     uint64_t seed = 1;  ///< for liblinear's shuffling
 };
@@ -89,8 +92,13 @@ struct ScheduleStep {
     double energyGraphCut = 0.0;  ///< E after alpha-expansion
     size_t partitions = 0;        ///< connected label regions
     size_t oversized = 0;         ///< regions that do not fit the printer
-    int sweeps = 0;
-    int expansions = 0;
+    int sweeps = 0;               ///< node-level passes (the band refinement with two levels)
+    int expansions = 0;           ///< node-level max-flow solves
+    // With two levels (graphNodeTarget): the cluster-level cut and the refinement band.
+    int clusterSweeps = 0;
+    int clusterExpansions = 0;
+    double energyClusters = 0.0;  ///< E of the cluster-level result
+    size_t bandNodes = 0;         ///< nodes free in the refinement
     double seconds = 0.0;
 };
 
@@ -132,8 +140,10 @@ struct PartitionResult {
     size_t merges = 0;                      ///< small pieces merged into a neighbour
     size_t svmSamples = 0;                  ///< training samples used
     double svmAgreement = 0.0;              ///< fraction of faces whose cell matches its region
-    size_t graphNodes = 0;                  ///< graph-cut nodes (faces, clusters, salient regions)
-    size_t candidatePairs = 0;              ///< Σ candidates over nodes: the "triangles × labels"
+    size_t graphNodes = 0;                  ///< nodes of the first graph cut (faces or clusters;
+                                            ///< a salient region is one node)
+    size_t refineNodes = 0;                 ///< nodes of the refinement level (faces or small clusters)
+    size_t candidatePairs = 0;              ///< Σ candidates over those nodes: "triangles × labels"
     double secondsGraphCut = 0.0;
     double secondsSvm = 0.0;
     double secondsTotal = 0.0;

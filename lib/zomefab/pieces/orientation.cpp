@@ -85,7 +85,7 @@ Placement bestTurn(const std::vector<std::array<double, 2>>& hull, double height
 
 struct Candidate {
     Placement placement;
-    std::array<Vec3d, 3> rows;
+    std::array<Vec3d, 3> rows{};
 };
 
 Candidate evaluate(const std::vector<Vec3d>& points, const Vec3d& down, const Vec3d& printer) {
@@ -130,12 +130,17 @@ std::vector<CutFace> measureCutFaces(const TriMesh& mesh, const std::vector<CutF
 }
 
 PrintOrientation orientForPrinter(const std::vector<Vec3d>& points, const std::vector<CutFace>& cutFaces,
-                                  const Vec3d& printer) {
+                                  const Vec3d& printer, double flatToleranceMm) {
     PrintOrientation out;
     if (points.empty()) return out;
     Candidate chosen;
     bool isChosen = false;
     for (const CutFace& f : cutFaces) {
+        // Only a face the whole piece lies behind can rest on the bed: a piece made of several
+        // cells (a merged sliver) may reach beyond the plane of one of its faces.
+        double beyond = -1e300;
+        for (const Vec3d& p : points) beyond = std::max(beyond, dot(f.outwardNormal, p) + f.offsetMm);
+        if (beyond > flatToleranceMm) continue;
         Candidate c = evaluate(points, f.outwardNormal, printer);
         if (c.placement.ratio <= 1.0) {
             chosen = c;

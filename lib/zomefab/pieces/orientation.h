@@ -34,10 +34,11 @@ struct PrintOrientation {
 };
 
 /// The orientation of the points @p pointsMm (a piece's vertices) for a printer of @p printerMm
-/// (x, y = bed, z = height). Tries the cut faces, largest first, each turned about the vertical for
-/// the best fit on the bed; the first that fits wins. Otherwise searches 6 axis and 250 sphere
-/// directions for the one with the most room; fits = false when none fits. Deterministic.
+/// (x, y = bed, z = height). Tries the cut faces, largest first, that no point lies beyond by more
+/// than @p flatToleranceMm, each turned about the vertical for the best fit on the bed; the first
+/// that fits wins. Otherwise searches 6 axis and 250 sphere directions for the one with the most
+/// room; fits = false when none fits. Deterministic.
 PrintOrientation orientForPrinter(const std::vector<Vec3d>& pointsMm, const std::vector<CutFace>& cutFaces,
-                                  const Vec3d& printerMm);
+                                  const Vec3d& printerMm, double flatToleranceMm = 0.01);
 
 }  // namespace zomefab::pieces

@@ -12,6 +12,7 @@
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/Prune.h>
+#include <openvdb/tools/VolumeToMesh.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -259,6 +260,78 @@ struct Component {
     uint32_t group = 0;  ///< request index, or requests.size() + component index for an orphan
 };
 
+/// Drops the vertex-connected components of @p mesh enclosing less than @p minVolumeMm3: specks
+/// the mesher leaves where the iso-surface grazes a voxel. Returns how many were dropped.
+size_t dropSpecks(TriMesh& mesh, double minVolumeMm3) {
+    const size_t nv = mesh.positions.size();
+    DisjointSets sets(nv);
+    for (const Triangle& t : mesh.triangles) {
+        sets.unite(t[0], t[1]);
+        sets.unite(t[0], t[2]);
+    }
+    std::vector<double> volume6(nv, 0.0);
+    for (const Triangle& t : mesh.triangles) {
+        const uint32_t root = sets.find(t[0]);
+        const Vec3d o = toD(mesh.positions[root]);  // well conditioned far from the origin
+        const Vec3d a = sub(toD(mesh.positions[t[0]]), o), b = sub(toD(mesh.positions[t[1]]), o),
+                    c = sub(toD(mesh.positions[t[2]]), o);
+        volume6[root] += dot(a, cross(b, c));
+    }
+    std::vector<Triangle> kept;
+    kept.reserve(mesh.triangles.size());
+    std::vector<uint8_t> isCounted(nv, 0);
+    size_t dropped = 0;
+    for (const Triangle& t : mesh.triangles) {
+        const uint32_t root = sets.find(t[0]);
+        if (std::abs(volume6[root]) / 6.0 >= minVolumeMm3) kept.push_back(t);
+        else if (!isCounted[root]) isCounted[root] = 1, ++dropped;
+    }
+    if (dropped == 0) return 0;
+    std::vector<uint32_t> index(nv, kNone);
+    std::vector<Vec3f> positions;
+    for (Triangle& t : kept)
+        for (uint32_t& v : t) {
+            if (index[v] == kNone) index[v] = uint32_t(positions.size()), positions.push_back(mesh.positions[v]);
+            v = index[v];
+        }
+    mesh.positions = std::move(positions);
+    mesh.triangles = std::move(kept);
+    return dropped;
+}
+
+/// A piece's grid → closed, outward triangles (quads split along the shorter diagonal), specks
+/// under @p minVolumeMm3 dropped. Deterministic: OpenVDB's output order for a given grid.
+TriMesh meshGrid(openvdb::tools::VolumeToMesh& mesher, const FloatGrid& grid, double minVolumeMm3) {
+    mesher(grid);
+    TriMesh mesh;
+    const size_t pointCount = mesher.pointListSize();
+    const openvdb::tools::PointList& points = mesher.pointList();
+    mesh.positions.resize(pointCount);
+    for (size_t i = 0; i < pointCount; ++i) mesh.positions[i] = {points[i][0], points[i][1], points[i][2]};
+    const openvdb::tools::PolygonPoolList& pools = mesher.polygonPoolList();
+    auto d2 = [&](uint32_t a, uint32_t b) { return (points[a] - points[b]).lengthSqr(); };
+    for (size_t n = 0; n < mesher.polygonPoolListSize(); ++n) {
+        const openvdb::tools::PolygonPool& pool = pools[n];
+        // OpenVDB winds clockwise seen from outside; zomefab's meshes are counter-clockwise.
+        for (size_t i = 0; i < pool.numQuads(); ++i) {
+            const openvdb::Vec4I& q = pool.quad(i);
+            if (d2(q[0], q[2]) <= d2(q[1], q[3])) {
+                mesh.triangles.push_back({q[0], q[2], q[1]});
+                mesh.triangles.push_back({q[0], q[3], q[2]});
+            } else {
+                mesh.triangles.push_back({q[0], q[3], q[1]});
+                mesh.triangles.push_back({q[1], q[3], q[2]});
+            }
+        }
+        for (size_t i = 0; i < pool.numTriangles(); ++i) {
+            const openvdb::Vec3I& t = pool.triangle(i);
+            mesh.triangles.push_back({t[0], t[2], t[1]});
+        }
+    }
+    dropSpecks(mesh, minVolumeMm3);
+    return mesh;
+}
+
 void checkRigid(const Transform4d& t) {
     // Columns orthonormal and a proper rotation: frame and shell were scaled alike and not mirrored.
     double det = 0;
@@ -426,49 +499,81 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
             comps[c].group = cellRequests[comps[c].cell][best];
         }
     }
-    if (out.outsideCellsVolumeMm3 > 0)
-        context.warn(number(out.outsideCellsVolumeMm3) + " mm³ of the shell lie in cells that no partition piece names; "
-                                                         "they become pieces of their own");
-
-    // Components of one request that touch form one piece; then slivers join a neighbour.
+    // Components of one request that touch form one piece. Then two kinds of pieces join the
+    // neighbour they share the largest cut face with: the parts of the shell in cells that no
+    // request names (cells with no outer surface: the partition meant no piece there), whatever
+    // their size, and slivers below minPieceVolumeMm3. Never dropped: with no neighbour they stay.
     DisjointSets pieceSets(comps.size());
     for (const auto& [pair, count] : contacts)
         if (comps[pair.first].group == comps[pair.second].group) pieceSets.unite(pair.first, pair.second);
     std::vector<double> rootVolume(comps.size(), 0.0);
     std::vector<uint32_t> rootSlivers(comps.size(), 0);
-    for (size_t c = 0; c < comps.size(); ++c) rootVolume[pieceSets.find(uint32_t(c))] += double(comps[c].voxels) * voxelVolume;
-    {
+    std::vector<uint8_t> isOrphan(comps.size(), 0);  // per root: only components of unnamed cells
+    for (size_t c = 0; c < comps.size(); ++c) {
+        rootVolume[pieceSets.find(uint32_t(c))] += double(comps[c].voxels) * voxelVolume;
+        isOrphan[c] = comps[c].group >= requests.size();
+    }
+    auto mergeIntoNeighbour = [&](uint32_t root, bool isOrphanPass) {
+        std::map<uint32_t, size_t> shared;  // neighbour root → contact voxel faces
+        for (const auto& [pair, count] : contacts) {
+            const uint32_t ra = pieceSets.find(pair.first), rb = pieceSets.find(pair.second);
+            if (ra == rb) continue;
+            if (ra == root) shared[rb] += count;
+            else if (rb == root) shared[ra] += count;
+        }
+        if (shared.empty()) return false;
+        // Largest contact, named pieces before unnamed ones; ties to the lowest root.
+        uint32_t target = kNone;
+        for (const auto& [r, count] : shared) {
+            if (target == kNone) {
+                target = r;
+                continue;
+            }
+            const bool isBetterKind = isOrphan[target] && !isOrphan[r];
+            const bool isSameKind = isOrphan[target] == isOrphan[r];
+            if (isBetterKind || (isSameKind && count > shared[target])) target = r;
+        }
+        const double volume = rootVolume[root] + rootVolume[target];
+        const uint32_t slivers = rootSlivers[root] + rootSlivers[target] + (isOrphanPass ? 0 : 1);
+        const bool isStillOrphan = isOrphan[root] && isOrphan[target];
+        pieceSets.unite(root, target);
+        const uint32_t merged = pieceSets.find(root);
+        rootVolume[merged] = volume;
+        rootSlivers[merged] = slivers;
+        isOrphan[merged] = isStillOrphan;
+        return true;
+    };
+    auto rootsByVolume = [&] {
         std::vector<uint32_t> roots;
         for (size_t c = 0; c < comps.size(); ++c)
             if (pieceSets.find(uint32_t(c)) == c) roots.push_back(uint32_t(c));
-        std::stable_sort(roots.begin(), roots.end(),
-                         [&](uint32_t a, uint32_t b) { return rootVolume[a] < rootVolume[b]; });
-        for (uint32_t r0 : roots) {
+        std::stable_sort(roots.begin(), roots.end(), [&](uint32_t a, uint32_t b) { return rootVolume[a] < rootVolume[b]; });
+        return roots;
+    };
+    size_t orphansKept = 0;
+    for (bool isChanged = true; isChanged;) {
+        isChanged = false;
+        orphansKept = 0;
+        for (uint32_t r0 : rootsByVolume()) {
             const uint32_t root = pieceSets.find(r0);
-            if (rootVolume[root] >= opt.minPieceVolumeMm3) continue;
-            std::map<uint32_t, size_t> shared;  // neighbour root → contact voxel faces
-            for (const auto& [pair, count] : contacts) {
-                const uint32_t ra = pieceSets.find(pair.first), rb = pieceSets.find(pair.second);
-                if (ra == rb) continue;
-                if (ra == root) shared[rb] += count;
-                else if (rb == root) shared[ra] += count;
-            }
-            if (shared.empty()) {
-                ++out.isolatedSlivers;
-                context.warn("a " + number(rootVolume[root]) +
-                             " mm³ piece touches no other piece and cannot be merged: it is kept as it is");
-                continue;
-            }
-            uint32_t target = shared.begin()->first;
-            for (const auto& [r, count] : shared)
-                if (count > shared[target]) target = r;
-            const double volume = rootVolume[root] + rootVolume[target];
-            const uint32_t slivers = rootSlivers[root] + rootSlivers[target] + 1;
-            pieceSets.unite(root, target);
-            const uint32_t merged = pieceSets.find(root);
-            rootVolume[merged] = volume;
-            rootSlivers[merged] = slivers;
+            if (root != r0 || !isOrphan[root]) continue;
+            if (mergeIntoNeighbour(root, true)) isChanged = true;
+            else ++orphansKept;
+        }
+    }
+    if (out.outsideCellsVolumeMm3 > 0)
+        context.warn(number(out.outsideCellsVolumeMm3) +
+                     " mm³ of the shell lie in cells that no partition piece names; merged into their neighbours" +
+                     (orphansKept ? " (" + std::to_string(orphansKept) + " with no neighbour kept as pieces)" : ""));
+    for (uint32_t r0 : rootsByVolume()) {
+        const uint32_t root = pieceSets.find(r0);
+        if (rootVolume[root] >= opt.minPieceVolumeMm3) continue;
+        if (mergeIntoNeighbour(root, false)) {
             ++out.sliversMerged;
+        } else {
+            ++out.isolatedSlivers;
+            context.warn("a " + number(rootVolume[root]) +
+                         " mm³ piece touches no other piece and cannot be merged: it is kept as it is");
         }
     }
     // Piece order: by the lowest request they come from, then by their first voxel.
@@ -577,9 +682,11 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
     ShellProbe probe;
     probe.voxelMm = voxel;
     probe.signedDistanceMm = [&](const Vec3d& p) { return double(sampler.wsSample(openvdb::Vec3d(p[0], p[1], p[2]))); };
+    // The owner of the nearest voxel, band voxels included: a point the trilinear φ puts just
+    // inside the wall may have its nearest voxel centre just outside.
     probe.pieceAt = [&](const Vec3d& p) -> int64_t {
         const size_t s = field.slotAt(p);
-        if (s == SIZE_MAX || !field.isInside(s)) return -1;
+        if (s == SIZE_MAX || field.owner[s] == kNone) return -1;
         return int64_t(field.owner[s]);
     };
     if (opt.tenons.maxPerPiece > 0) {
@@ -647,7 +754,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
     leafPieces.clear();
 
     const float bg = field.background;
-    std::atomic<size_t> done{0};
+    std::vector<FloatGrid::Ptr> grids(pieceCount);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, pieceCount, 1), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t p = range.begin(); p < range.end(); ++p) {
             context.throwIfCancelled();
@@ -714,18 +821,34 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
                 }
             }
             openvdb::tools::pruneLevelSet(grid->tree());
+            grids[p] = std::move(grid);
+        }
+    });
+    context.throwIfCancelled();
+    context.progress("pieces", 0.5);
+    field = VoxelField();
 
-            sdf::LevelSetInfo info = shellSet.info();
-            info.name = "piece";
-            info.exteriorBandMm = 0;
-            info.interiorBandMm = 0;
-            sdf::LevelSetToMeshOptions meshing;
-            meshing.adaptivity = opt.adaptivity;
-            TriMesh mesh;
-            tbb::this_task_arena::isolate([&] {
-                mesh = sdf::levelSetToMesh(sdf::wrapLevelSetGrid(grid, info), meshing, RunContext::silent());
-            });
-            grid.reset();
+    // Meshing. Not OpenVDB's fracture scheme (VolumeToMesh::setRefGrid): it snaps the seam
+    // vertices to the uncut shell's surface, up to a voxel beyond the cut planes, so cut faces
+    // would not be flat and neighbours would overlap at their rims (measured, docs/pieces.md).
+    std::vector<TriMesh> meshes(pieceCount);
+    std::atomic<size_t> meshed{0};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, pieceCount, 1), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t p = range.begin(); p < range.end(); ++p) {
+            context.throwIfCancelled();
+            openvdb::tools::VolumeToMesh mesher(0.0, opt.adaptivity, /*relaxDisorientedTriangles=*/true);
+            tbb::this_task_arena::isolate([&] { meshes[p] = meshGrid(mesher, *grids[p], voxelVolume); });
+            grids[p].reset();
+            context.progress("pieces", 0.5 + 0.4 * double(++meshed) / double(pieceCount));
+        }
+    });
+    context.throwIfCancelled();
+
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, pieceCount, 1), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t p = range.begin(); p < range.end(); ++p) {
+            Piece& piece = out.pieces[p];
+            const CellSet& set = cellSets[p];
+            TriMesh mesh = std::move(meshes[p]);
             const mesh::MeshReport report = mesh::checkMesh(mesh);
             if (report.boundaryEdges > 0 || report.nonManifoldEdges > 0 || !(report.volume > 0))
                 throw Error(ErrorCode::ProcessingFailed,
@@ -765,7 +888,6 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
             piece.extentsMm = orientation.extentsMm;
             transformInPlace(mesh, orientation.transformMm);
             piece.mesh = std::move(mesh);
-            context.progress("pieces", 0.35 + 0.65 * double(++done) / double(pieceCount));
         }
     });
     context.throwIfCancelled();

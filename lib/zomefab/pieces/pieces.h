@@ -96,7 +96,8 @@ struct Pieces {
     Vec3d printerMm{200, 200, 200};
     double voxelMm = 0.0;
     double shellVolumeMm3 = 0.0;        ///< the shell, counted in voxels
-    double outsideCellsVolumeMm3 = 0.0; ///< shell volume in cells no request names (own pieces)
+    /// Shell volume in cells no request names (no outer surface there): merged into neighbours.
+    double outsideCellsVolumeMm3 = 0.0;
     size_t sliversMerged = 0;
     size_t isolatedSlivers = 0;         ///< small pieces with no neighbour to merge into (kept)
     Transform4d frameToGridMm;
@@ -111,7 +112,8 @@ struct Pieces {
 /// @param frameToGridMm frame mm → grid mm: T_grid · T_frame⁻¹ of the two transform_mm; must be a
 ///                      rotation plus a translation (the two were scaled alike)
 /// @param cells         the partition's cells, frame mm
-/// @param requests      the partition's pieces (cells in no request give pieces of their own)
+/// @param requests      the partition's pieces; the shell in cells no request names joins the
+///                      neighbouring pieces
 /// @throw Error(Usage) for bad options or a voxel too coarse for the tenon pegs;
 ///        Error(InvalidInput) for an empty shell, a request naming an unknown cell, mismatched
 ///        cell arrays, or a frameToGridMm that scales; Error(ProcessingFailed) when a piece fits

@@ -83,7 +83,9 @@ Box3d tenonBoundsMm(const Tenon& tenon, const TenonOptions& options);
 /// What the planner asks about the shell and its pieces, in the grid's mm. Serial use.
 struct ShellProbe {
     std::function<double(const Vec3d&)> signedDistanceMm;  ///< φ of the shell, trilinear
-    std::function<int64_t(const Vec3d&)> pieceAt;          ///< piece of the voxel at a point, −1 outside
+    /// The piece owning the voxel nearest to a point in the wall or within its narrow band; −1
+    /// farther out. Callers ask φ first: only points with φ < 0 are in the piece's material.
+    std::function<int64_t(const Vec3d&)> pieceAt;
     double voxelMm = 1.0;
 };
 

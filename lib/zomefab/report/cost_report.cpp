@@ -26,8 +26,7 @@ nlohmann::json printJson(const PrintEstimate& e) {
     nlohmann::json j = {{"parts", e.parts}, {"hours", e.hours()}, {"filament_mm3", e.filamentMm3}};
     if (e.partVolumeMm3 > 0.0)
         j["model"] = {{"part_volume_mm3", e.partVolumeMm3},
-                      {"external_perimeter_mm3", e.externalPerimeterMm3},
-                      {"inner_perimeter_mm3", e.innerPerimeterMm3},
+                      {"perimeter_mm3", e.perimeterMm3},
                       {"solid_layers_mm3", e.solidMm3},
                       {"infill_mm3", e.infillMm3},
                       {"layers", e.layers}};

@@ -204,6 +204,9 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
     if (!input.pieceNames.empty() && input.pieceNames.size() != input.pieces.size())
         throw Error(ErrorCode::Usage, "preview: " + std::to_string(input.pieceNames.size()) + " piece names for " +
                                           std::to_string(input.pieces.size()) + " pieces");
+    if (!input.pieceTransforms.empty() && input.pieceTransforms.size() != input.pieces.size())
+        throw Error(ErrorCode::Usage, "preview: " + std::to_string(input.pieceTransforms.size()) +
+                                          " piece transforms for " + std::to_string(input.pieces.size()) + " pieces");
     if (options.sphereSubdivisions < 0 || options.sphereSubdivisions > 5)
         throw Error(ErrorCode::Usage, "preview: sphere subdivisions must be 0..5");
     GlbScene scene;
@@ -236,6 +239,7 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
             mesh.name = name;
             mesh.geometry = input.pieces[i];
             mesh.geometry.salientFaces.clear();
+            if (!input.pieceTransforms.empty()) transformInPlace(mesh.geometry, input.pieceTransforms[i]);
             mesh.material = int(scene.materials.size() - 1);
             mesh.isDracoCompressed = options.isPieceDracoCompressed;
             scene.meshes.push_back(std::move(mesh));
@@ -261,12 +265,7 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
         const int ballMaterial = int(scene.materials.size() - 1);
         // Zometool's colours, sRGB.
         const std::array<std::array<double, 3>, 3> strutRgb = {{{0.05, 0.33, 0.75}, {1.0, 0.80, 0.05}, {0.85, 0.10, 0.10}}};
-        std::array<int, zome::kColorCount> strutMaterial{};
-        for (int c = 0; c < zome::kColorCount; ++c) {
-            const auto& rgb = strutRgb[size_t(c)];
-            scene.materials.push_back(material(std::string("strut-") + zome::colorName(zome::Color(c)), rgb[0], rgb[1], rgb[2]));
-            strutMaterial[size_t(c)] = int(scene.materials.size() - 1);
-        }
+        std::array<int, zome::kColorCount> strutMaterial{-1, -1, -1};  // created on first use
 
         const std::vector<zome::BallId> balls = frame.ballIds();
         if (!balls.empty()) {
@@ -303,7 +302,14 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
                                                           " strut is long");
                     GlbMesh prismMeshValue = prismMesh("strut-" + zome::partName(s.color, s.size),
                                                        strutCrossSection(s.color), lengthMm);
-                    prismMeshValue.material = strutMaterial[size_t(s.color)];
+                    int& colour = strutMaterial[size_t(s.color)];
+                    if (colour < 0) {
+                        const auto& rgb = strutRgb[size_t(s.color)];
+                        scene.materials.push_back(
+                            material(std::string("strut-") + zome::colorName(s.color), rgb[0], rgb[1], rgb[2]));
+                        colour = int(scene.materials.size() - 1);
+                    }
+                    prismMeshValue.material = colour;
                     scene.meshes.push_back(std::move(prismMeshValue));
                     mesh = int(scene.meshes.size() - 1);
                 }

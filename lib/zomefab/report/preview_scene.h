@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "zomefab/core/transform.h"
 #include "zomefab/core/tri_mesh.h"
 #include "zomefab/io/glb_write.h"
 #include "zomefab/zome/structure.h"
@@ -17,8 +18,12 @@ namespace zomefab::report {
 
 /// What the preview shows. Everything in the model's millimetres, z up.
 struct PreviewInput {
-    std::vector<TriMesh> pieces;          ///< closed piece meshes where they sit in the model
+    std::vector<TriMesh> pieces;          ///< closed piece meshes
     std::vector<std::string> pieceNames;  ///< node names, one per piece; empty = "piece-00", ...
+    /// Empty (the pieces already sit where they belong in the frame's mm), or one transform per
+    /// piece taking it there, e.g. printer → frame mm: affineInverse(frameToGridMm) ·
+    /// affineInverse(piece.gridToPrintMm) for pieces in their print orientation.
+    std::vector<Transform4d> pieceTransforms;
     const zome::Structure* frame = nullptr;  ///< the Zometool frame; null = pieces only
     /// Merged into scenes[0].extras next to the parts list (e.g. the run's summary); null = none.
     nlohmann::json extras;
@@ -45,7 +50,7 @@ Vec3d strutCrossSectionFrame(int hole);
 
 /// Builds the scene. Node names: "piece-NN" (or pieceNames), "ball-<id>", "strut-<id>" with the
 /// frame's ids; group nodes "zomefab" (root), "pieces", "balls", "struts".
-/// @throw Error(Usage) when pieceNames has the wrong size, a piece is empty, or the frame's ball is
+/// @throw Error(Usage) when pieceNames or pieceTransforms has the wrong size, a piece is empty, or the frame's ball is
 ///   at least as wide as its shortest strut is long.
 GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& options = {});
 

@@ -42,8 +42,7 @@ PrintEstimate& PrintEstimate::operator+=(const PrintEstimate& o) {
     seconds += o.seconds;
     filamentMm3 += o.filamentMm3;
     partVolumeMm3 += o.partVolumeMm3;
-    externalPerimeterMm3 += o.externalPerimeterMm3;
-    innerPerimeterMm3 += o.innerPerimeterMm3;
+    perimeterMm3 += o.perimeterMm3;
     solidMm3 += o.solidMm3;
     infillMm3 += o.infillMm3;
     layers += o.layers;
@@ -105,17 +104,14 @@ PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const P
     const double interior = std::max(0.0, volume - perimeterMm3 - solidMm3);
     const bool isSolid = s.infillPercent >= 100.0;
     e.partVolumeMm3 = volume;
-    e.externalPerimeterMm3 = perimeterMm3 * (w / wallMm);
-    e.innerPerimeterMm3 = perimeterMm3 - e.externalPerimeterMm3;
+    e.perimeterMm3 = perimeterMm3;
     e.solidMm3 = solidMm3;
     e.infillMm3 = isSolid ? interior : interior * std::min(1.0, 0.01 * s.infillPercent * rates.sparseInfillFactor);
     e.filamentMm3 = perimeterMm3 + solidMm3 + e.infillMm3;
     const double height = zMax - zMin;
     e.layers = height <= s.firstLayerHeightMm ? 1 : 1 + size_t(std::ceil((height - s.firstLayerHeightMm) / h - 1e-9));
-    e.seconds = e.externalPerimeterMm3 * rates.externalPerimeterSPerMm3 +
-                e.innerPerimeterMm3 * rates.innerPerimeterSPerMm3 + e.solidMm3 * rates.solidSPerMm3 +
-                e.infillMm3 * (isSolid ? rates.solidInfillSPerMm3 : rates.sparseInfillSPerMm3) +
-                double(e.layers) * rates.layerS;
+    e.seconds = e.perimeterMm3 * rates.perimeterSPerMm3 + e.solidMm3 * rates.solidSPerMm3 +
+                e.infillMm3 * (isSolid ? rates.solidInfillSPerMm3 : rates.sparseInfillSPerMm3);
     return e;
 }
 

@@ -31,18 +31,19 @@ struct PrintSettings {
     void validate() const;
 };
 
-/// Rates of the time model and the infill factor: seconds per mm³ of each extrusion kind plus a
-/// fixed cost per layer. Defaults are the least-squares fit to PrusaSlicer 2.5.0 on the
-/// calibration parts of docs/report.md (tests/report/report_calibration.cpp re-runs the fit).
+/// Rates of the time model and the infill factor: seconds per mm³ of each kind of extrusion.
+/// Defaults: the least-squares fit (relative errors) to PrusaSlicer 2.5.0 over the 28 calibration
+/// slices of docs/report.md; tests/report/report_calibration.cpp re-runs the fit. A per-layer
+/// term was tried and fitted to zero, and the outer and inner perimeters cannot be told apart by
+/// this model (their volumes are proportional), so each has one rate.
 struct PrintRates {
-    double externalPerimeterSPerMm3 = 0.34;  ///< outermost loop, half the perimeter speed
-    double innerPerimeterSPerMm3 = 0.19;     ///< the other loops
-    double solidSPerMm3 = 0.46;              ///< top and bottom solid layers (20 mm/s in PrusaSlicer)
-    double sparseInfillSPerMm3 = 0.16;       ///< sparse infill below 100 %
-    double solidInfillSPerMm3 = 0.16;        ///< interior at 100 % infill (still at infill speed)
-    double layerS = 1.0;                     ///< per layer: travel, z move, retractions
-    /// Filament in sparse infill per mm³ of interior and per unit of density (1 = the nominal %).
-    double sparseInfillFactor = 1.0;
+    double perimeterSPerMm3 = 0.419;     ///< 2.39 mm³/s: loops at 30 (outer) and 60 mm/s
+    double solidSPerMm3 = 0.498;         ///< 2.01 mm³/s: top/bottom solid layers at 15-20 mm/s
+    double sparseInfillSPerMm3 = 0.151;  ///< 6.6 mm³/s: sparse infill at 80 mm/s
+    double solidInfillSPerMm3 = 0.168;   ///< 6.0 mm³/s: the interior at 100 % (still infill speed)
+    /// Plastic in sparse infill per mm³ of interior and per unit of nominal density: PrusaSlicer's
+    /// triangles at 20 % lay down 6.8 % more than 20 % of the interior volume.
+    double sparseInfillFactor = 1.068;
 };
 
 /// Filament and its price. Default: the paper's 0.56 USD per metre of 2.85 mm PLA (§7.2).
@@ -60,8 +61,7 @@ struct PrintEstimate {
     double filamentMm3 = 0.0;  ///< volume of plastic extruded
     // The model's breakdown (zero when the numbers come from a slicer):
     double partVolumeMm3 = 0.0;
-    double externalPerimeterMm3 = 0.0;
-    double innerPerimeterMm3 = 0.0;
+    double perimeterMm3 = 0.0;  ///< perimeter loops
     double solidMm3 = 0.0;     ///< top/bottom solid layers
     double infillMm3 = 0.0;    ///< plastic in the interior
     size_t layers = 0;         ///< summed over parts
@@ -84,7 +84,7 @@ FilamentUse filamentUse(double filamentMm3, const FilamentOptions& filament);
 /// A·t_w·sin θ and the top/bottom solid layers A·max(0, t_s·|cos θ| − t_w·sin θ), with
 /// t_w = w + (perimeters − 1)·(w − h(1 − π/4)) and t_s the solid layers' height; both are scaled
 /// down together when they exceed the part's volume (thin parts are solid). The rest of the volume
-/// is infill at the given density. Time = Σ volume·rate + layers·layerS. O(F), deterministic.
+/// is infill at the given density. Time = Σ volume·rate. O(F), deterministic.
 PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& settings, const PrintRates& rates = {});
 
 /// The parts of the paper's baseline (§7.2): the object's bounding box is split as an octree and

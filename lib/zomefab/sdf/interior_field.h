@@ -72,7 +72,7 @@ public:
     bool isInside(const Vec3d& pointMm) const { return signedDistanceMm(pointMm) < 0; }
     /// δ(p) = p − φ(p)·∇φ/|∇φ|, the nearest surface point (paper §4.3.1), with ∇φ from central
     /// differences (more accurate in direction than sample()'s gradient) and a second step from
-    /// the first foot point. About 4× the cost of sample(). Near the medial axis (where several
+    /// the first foot point. About 8× the cost of sample(). Near the medial axis (where several
     /// surface points are nearly as close) the answer is one of them; where the gradient vanishes
     /// (clamped values far outside) returns @p pointMm itself.
     Vec3d closestSurfacePointMm(const Vec3d& pointMm) const;

@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <doctest/doctest.h>
+
+#include <string>
+
+#include "frame_fixtures.h"
+#include "zomefab/core/error.h"
+#include "zomefab/frame/frame.h"
+#include "zomefab/frame/lattice.h"
+
+using namespace zomefab;
+
+TEST_CASE("lattice: B0 cubes in a 300 mm sphere keep dMin and are connected") {
+    const sdf::InteriorField& field = test::sphereField(300.0);
+    frame::LatticeOptions o;
+    const frame::LatticeResult r = frame::initialLattice(field, o, RunContext::silent());
+    CHECK(r.cubes > 0);
+    CHECK(r.keptCubes == r.cubes);  // a sphere's cubes form one part
+    CHECK(r.placementsTried == 216);
+    CHECK(r.cubes >= r.firstPlacementCubes);  // the search never loses
+    const zome::Structure& s = r.structure;
+    // Every strut is B0 along x, y or z; each ball has the three cube directions only.
+    const zome::PartsList parts = zome::partsList(s);
+    CHECK(parts.count(zome::Color::Blue, 0) == s.strutCount());
+    const frame::FrameField ff(field, r.rotationDeg, s.scale(), o.zone);
+    CHECK(frame::verifyFrame(s, ff).empty());
+    for (zome::BallId id : s.ballIds())
+        CHECK(ff.depthMm(s.ball(id).positionMm) >= o.zone.dMinMm + s.scale().ballRadiusMm());
+    // Deterministic whatever the thread count (the placement search runs in parallel).
+    const frame::LatticeResult again = frame::initialLattice(field, o, RunContext::silent());
+    CHECK(again.offsetMm == r.offsetMm);
+    CHECK(again.structure.ballCount() == s.ballCount());
+}
+
+TEST_CASE("lattice: the rotation search is an option and goes into the frame transform") {
+    const sdf::InteriorField& field = test::sphereField(300.0);
+    frame::LatticeOptions o;
+    o.offsetSteps = 2;
+    o.searchRotation = true;
+    o.rotationStepDeg = 30.0;
+    const frame::LatticeResult r = frame::initialLattice(field, o, RunContext::silent());
+    CHECK(r.placementsTried == 3 * 8);
+    CHECK(r.cubes > 0);
+    // transform_mm composes the field's transform with R(−rotation): a field point maps to the
+    // frame point the lattice sees.
+    const Transform4d t = frame::frameTransformMm(Transform4d::identity(), 30.0);
+    const frame::FrameField ff(field, 30.0, zome::ZomeScale{}, o.zone);
+    const Vec3d p{10.0, 20.0, 5.0};
+    const Vec3d q = t.apply(p);
+    const Vec3d back = ff.toFieldMm(q);
+    for (int a = 0; a < 3; ++a) CHECK(back[a] == doctest::Approx(p[a]));
+}
+
+TEST_CASE("lattice: an object too thin for one cube fails with the sizes involved") {
+    // A 400 × 400 × 80 mm slab: 40 mm deep at most, a cube needs 24.85 mm clearance around a 47.3 mm cube.
+    const sdf::InteriorField field =
+        test::interiorFieldOf(test::makeBox({-200, -200, -40}, {200, 200, 40}), 4.0);
+    try {
+        frame::initialLattice(field, {}, RunContext::silent());
+        FAIL("expected an error");
+    } catch (const Error& e) {
+        CHECK(e.code() == ErrorCode::ProcessingFailed);
+        const std::string m = e.message();
+        CHECK(m.find("too thin for one B0 cube") != std::string::npos);
+        CHECK(m.find("80.0 mm across") != std::string::npos);   // the slab's thickness
+        CHECK(m.find("97.0 mm across") != std::string::npos);   // 47.3 + 2 × 24.85
+    }
+}
+
+TEST_CASE("lattice: bad options are usage errors") {
+    const sdf::InteriorField& field = test::sphereField(300.0);
+    frame::LatticeOptions o;
+    o.offsetSteps = 0;
+    CHECK_THROWS_AS(frame::initialLattice(field, o, RunContext::silent()), Error);
+}

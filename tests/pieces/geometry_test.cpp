@@ -1,0 +1,438 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The OpenVDB-free parts of the pieces stage: tenon geometry and planning against an analytic
+// shell, the print orientation, the label glyphs, and the 3MF package.
+#include <doctest/doctest.h>
+#include <zlib.h>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+
+#include "test_util.h"
+#include "zomefab/core/error.h"
+#include "zomefab/core/transform.h"
+#include "zomefab/io/threemf.h"
+#include "zomefab/pieces/detail/vec.h"
+#include "zomefab/pieces/label.h"
+#include "zomefab/pieces/orientation.h"
+#include "zomefab/pieces/tenons.h"
+#include "zomefab/zome/golden.h"
+#include "zomefab/zome/zome_system.h"
+
+using namespace zomefab;
+using namespace zomefab::pieces;
+using namespace zomefab::pieces::detail;
+
+namespace {
+
+/// A spherical shell inner radius @p inner, outer @p outer around the origin, cut into two pieces
+/// at z = @p cutZ (piece 0 above).
+ShellProbe sphereProbe(double inner, double outer, double cutZ = 1e9) {
+    ShellProbe p;
+    p.voxelMm = 1.0;
+    p.signedDistanceMm = [=](const Vec3d& x) {
+        const double r = norm(x);
+        return std::max(r - outer, inner - r);
+    };
+    p.pieceAt = [=](const Vec3d& x) -> int64_t {
+        const double r = norm(x);
+        if (r < inner || r > outer) return -1;
+        return x[2] >= cutZ ? 0 : 1;
+    };
+    return p;
+}
+
+zome::Structure oneBall() {
+    zome::Structure s;
+    s.addBall(zome::GoldenVector3());
+    return s;
+}
+
+uint32_t readU32(const std::string& s, size_t at) {
+    uint32_t v = 0;
+    for (int i = 3; i >= 0; --i) v = (v << 8) | uint8_t(s[at + size_t(i)]);
+    return v;
+}
+uint16_t readU16(const std::string& s, size_t at) { return uint16_t(uint8_t(s[at]) | (uint8_t(s[at + 1]) << 8)); }
+
+/// Entries of a zip archive (local headers walked in order; deflated data inflated, CRC checked).
+std::map<std::string, std::string> unzip(const std::string& zip) {
+    std::map<std::string, std::string> out;
+    size_t at = 0;
+    while (at + 4 <= zip.size() && readU32(zip, at) == 0x04034b50) {
+        const uint16_t method = readU16(zip, at + 8);
+        const uint32_t crc = readU32(zip, at + 14), csize = readU32(zip, at + 18), usize = readU32(zip, at + 22);
+        const uint16_t nameLen = readU16(zip, at + 26), extraLen = readU16(zip, at + 28);
+        const std::string name = zip.substr(at + 30, nameLen);
+        const std::string body = zip.substr(at + 30 + nameLen + extraLen, csize);
+        std::string data;
+        if (method == 0) {
+            data = body;
+        } else {
+            REQUIRE(method == 8);
+            data.resize(usize);
+            z_stream z{};
+            REQUIRE(inflateInit2(&z, -15) == Z_OK);
+            z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(body.data()));
+            z.avail_in = uInt(body.size());
+            z.next_out = reinterpret_cast<Bytef*>(data.data());
+            z.avail_out = uInt(data.size());
+            CHECK(inflate(&z, Z_FINISH) == Z_STREAM_END);
+            inflateEnd(&z);
+        }
+        CHECK(data.size() == usize);
+        CHECK(uint32_t(crc32(0, reinterpret_cast<const Bytef*>(data.data()), uInt(data.size()))) == crc);
+        out[name] = data;
+        at += 30 + nameLen + extraLen + csize;
+    }
+    CHECK(readU32(zip, at) == 0x02014b50);  // the central directory follows the entries
+    CHECK(readU32(zip, zip.size() - 22) == 0x06054b50);
+    CHECK(readU16(zip, zip.size() - 22 + 10) == out.size());
+    return out;
+}
+
+size_t countOf(const std::string& text, const std::string& what) {
+    size_t n = 0;
+    for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+}
+
+}  // namespace
+
+TEST_CASE("transform: affineInverse undoes a rotation, scale and translation") {
+    Transform4d t = Transform4d::yUpToZUp() * Transform4d::scaleTranslate(2.5, {3, -4, 7});
+    const Transform4d inv = affineInverse(t);
+    const Vec3d p{1.5, -2.0, 9.0};
+    const Vec3d q = inv.apply(t.apply(p));
+    for (int a = 0; a < 3; ++a) CHECK(q[size_t(a)] == doctest::Approx(p[size_t(a)]).epsilon(1e-12));
+    Transform4d singular = Transform4d::scaleTranslate(0.0, {0, 0, 0});
+    CHECK_THROWS_AS(affineInverse(singular), Error);
+}
+
+TEST_CASE("tenons: the peg's long side follows the blue hole's golden rectangle") {
+    // +z hole: long side along x; +x: along y; +y: along z (zome-geometry.md §2); − holes alike.
+    CHECK(pegLongSideFrame(2) == Vec3d{1, 0, 0});
+    CHECK(pegLongSideFrame(0) == Vec3d{0, 1, 0});
+    CHECK(pegLongSideFrame(1) == Vec3d{0, 0, 1});
+    CHECK(pegLongSideFrame(17) == Vec3d{1, 0, 0});
+    CHECK(pegLongSideFrame(15) == Vec3d{0, 1, 0});
+    for (int hole : {0, 1, 2, 15, 16, 17}) CHECK(dot(pegLongSideFrame(hole), zome::holeDirection(hole)) == 0.0);
+}
+
+TEST_CASE("tenons: signed distance of the prism and the peg") {
+    TenonOptions o;
+    Tenon t;
+    t.axisGrid = {0, 0, 1};
+    t.longSideGrid = {1, 0, 0};
+    t.shoulderMm = 8.85;
+    t.pegTipMm = 8.85 - o.pegDepthMm;
+    t.baseMm = 30;
+    t.endMm = 32;
+    // Peg: 5.16 (x) × 3.08 (y) mm, from z = 4.85 to the shoulder.
+    CHECK(tenonSignedDistanceMm(t, o, {0, 0, 6}) < 0);
+    CHECK(tenonSignedDistanceMm(t, o, {0.5 * pegLongMm(o) + 0.1, 0, 6}) == doctest::Approx(0.1));
+    CHECK(tenonSignedDistanceMm(t, o, {0, 0.5 * pegShortMm(o) + 0.2, 6}) == doctest::Approx(0.2));
+    CHECK(tenonSignedDistanceMm(t, o, {0, 0, t.pegTipMm - 0.3}) == doctest::Approx(0.3));
+    // Prism: 7 × 7 mm from the shoulder to z = 32.
+    CHECK(tenonSignedDistanceMm(t, o, {3.4, 3.4, 20}) < 0);
+    CHECK(tenonSignedDistanceMm(t, o, {3.6, 0, 20}) == doctest::Approx(0.1));
+    CHECK(tenonSignedDistanceMm(t, o, {0, 0, 32.5}) == doctest::Approx(0.5));
+    // Beside the peg, below the shoulder: outside.
+    CHECK(tenonSignedDistanceMm(t, o, {3.0, 0, 7.0}) > 0);
+    const Box3d box = tenonBoundsMm(t, o);
+    CHECK(box.min[2] == doctest::Approx(t.pegTipMm));
+    CHECK(box.max[2] == doctest::Approx(32));
+    CHECK(box.max[0] == doctest::Approx(3.5));
+}
+
+TEST_CASE("tenons: options out of range are usage errors") {
+    auto code = [](const TenonOptions& o) {
+        try {
+            checkTenonOptions(o);
+        } catch (const Error& e) {
+            return int(e.code());
+        }
+        return -1;
+    };
+    TenonOptions o;
+    CHECK(code(o) == -1);
+    o.clearanceMm = 0.8;
+    CHECK(code(o) == int(ErrorCode::Usage));
+    o = {};
+    o.bodyWidthMm = 4.0;  // narrower than the peg's long side
+    CHECK(code(o) == int(ErrorCode::Usage));
+    o = {};
+    o.maxLengthMm = 0;
+    CHECK(code(o) == int(ErrorCode::Usage));
+    o = {};
+    o.maxPerPiece = 1;  // below the 2 wanted
+    CHECK(code(o) == int(ErrorCode::Usage));
+    o = {};
+    o.maxTiltDeg = 80;
+    CHECK(code(o) == int(ErrorCode::Usage));
+}
+
+TEST_CASE("tenons: rays from one ball in a spherical shell") {
+    const zome::Structure frame = oneBall();
+    TenonOptions o;
+    const double inner = 30.0;
+    const auto candidates = findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0, 5.0), o);
+    REQUIRE(candidates.size() == 6);
+    for (const TenonCandidate& c : candidates) {
+        INFO("hole " << c.tenon.hole);
+        CHECK(c.rejection.empty());
+        CHECK(c.tenon.baseMm == doctest::Approx(inner).epsilon(1e-6));
+        CHECK(c.tenon.tiltDeg < 1.0);
+        CHECK(c.tenon.shoulderMm == doctest::Approx(frame.scale().ballRadiusMm()));
+        CHECK(c.tenon.lengthMm() == doctest::Approx(inner - frame.scale().ballRadiusMm()).epsilon(1e-6));
+        CHECK(c.tenon.axisFrame == zome::holeDirection(c.tenon.hole));
+        // Up (+z) meets piece 0, the rest piece 1 (the cut is at z = 5).
+        CHECK(c.piece == (c.tenon.hole == 2 ? 0 : 1));
+    }
+    // Too far: a 15 mm limit (the rays look twice as far, so the wall 21 mm away is seen).
+    TenonOptions shortOnes = o;
+    shortOnes.maxLengthMm = 15;
+    for (const TenonCandidate& c : findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0), shortOnes))
+        CHECK(c.rejection == "too far from the wall");
+    // Nothing within reach.
+    for (const TenonCandidate& c : findTenonCandidates(frame, Transform4d::identity(), sphereProbe(200, 210), o))
+        CHECK(c.rejection == "no wall within reach");
+}
+
+TEST_CASE("tenons: used holes, obstacles, oblique walls and cut edges are rejected") {
+    // Ball 0 at the origin with a B0 strut in +x to ball 1; ball 2 sits in the +y path.
+    zome::Structure frame;
+    const zome::BallId a = frame.addBall(zome::GoldenVector3());
+    frame.addBall(zome::strutVector(0, 0));
+    frame.addStrut(a, 0, 0);
+    frame.addBall(zome::strutVector(1, 0));  // 47.3 mm along +y, no strut
+    TenonOptions o;
+    o.maxLengthMm = 80;
+    const auto candidates = findTenonCandidates(frame, Transform4d::identity(), sphereProbe(70, 80), o);
+    std::map<int, std::string> ofBall0;
+    for (const TenonCandidate& c : candidates)
+        if (c.tenon.ball == a) ofBall0[c.tenon.hole] = c.rejection;
+    CHECK(ofBall0[0] == "hole holds a strut");
+    CHECK(ofBall0[1] == "ball in the way");
+    CHECK(ofBall0[2].empty());
+    // The strut from ball 0 to ball 1 blocks ball 1's rays along ±z? No: they leave at 90°. But a
+    // ray from ball 1 in −x runs along the strut itself (its −x hole holds it).
+    for (const TenonCandidate& c : candidates)
+        if (c.tenon.ball == 1 && c.tenon.hole == 15) CHECK(c.rejection == "hole holds a strut");
+    CHECK(tenonObstruction(frame, candidates[1].tenon, o).rfind("ball 2", 0) == 0);
+
+    // An off-centre ball sees the sphere obliquely along its side axes.
+    zome::Structure off;
+    off.addBall(zome::strutVector(0, 1));  // 76.5 mm along +x
+    TenonOptions strict;
+    strict.maxLengthMm = 100;
+    strict.maxTiltDeg = 20;
+    bool sawOblique = false;
+    for (const TenonCandidate& c : findTenonCandidates(off, Transform4d::identity(), sphereProbe(100, 110), strict))
+        if (c.tenon.hole == 1) {
+            CHECK(c.rejection == "surface too oblique");
+            CHECK(c.tenon.tiltDeg > 20);
+            sawOblique = true;
+        }
+    CHECK(sawOblique);
+
+    // A cut through the axis: the prism's end face straddles two pieces.
+    const auto cut = findTenonCandidates(oneBall(), Transform4d::identity(), sphereProbe(30, 40, 0.5), o);
+    for (const TenonCandidate& c : cut)
+        if (c.tenon.hole == 0) CHECK(c.rejection == "crosses another piece");
+}
+
+TEST_CASE("tenons: the choice gives every piece its share, prefers one direction, keeps prisms apart") {
+    TenonOptions o;
+    o.minPerPiece = 2;
+    o.maxPerPiece = 3;
+    auto make = [](zome::BallId ball, int hole, const Vec3d& center, int64_t piece, double score) {
+        TenonCandidate c;
+        c.piece = piece;
+        c.score = score;
+        c.tenon.ball = ball;
+        c.tenon.hole = hole;
+        c.tenon.piece = uint32_t(piece);
+        c.tenon.axisGrid = zome::holeDirection(hole);
+        c.tenon.ballCenterGridMm = center;
+        c.tenon.shoulderMm = 8.85;
+        c.tenon.baseMm = 30;
+        c.tenon.endMm = 32;
+        return c;
+    };
+    std::vector<TenonCandidate> candidates = {
+        make(0, 2, {0, 0, 0}, 0, 0.9),     // A: piece 0's best, +z
+        make(1, 1, {100, 0, 0}, 0, 0.8),   // B: piece 0, +y
+        make(2, 2, {0, 100, 0}, 0, 0.5),   // C: piece 0, +z like A
+        make(3, 2, {3, 0, 0}, 1, 0.95),    // D: piece 1, 3 mm beside A: prisms would touch
+        make(4, 0, {0, -200, 0}, 1, 0.7),  // E: piece 1
+    };
+    candidates.push_back(make(5, 0, {0, 300, 0}, 1, 0.99));
+    candidates.back().rejection = "surface too oblique";
+    const TenonPlan plan = chooseTenons(candidates, 3, o);
+    REQUIRE(plan.perPiece.size() == 3);
+    REQUIRE(plan.perPiece[0].size() == 3);
+    CHECK(plan.perPiece[0][0].ball == 0);
+    CHECK(plan.perPiece[0][1].ball == 2);  // parallel to the first, though B scores higher
+    CHECK(plan.perPiece[0][2].ball == 1);
+    REQUIRE(plan.perPiece[1].size() == 1);
+    CHECK(plan.perPiece[1][0].ball == 4);  // D lost to A, which was chosen first
+    CHECK(plan.shortfall[0].empty());
+    CHECK(plan.shortfall[1].at("another tenon in the way") == 1);
+    CHECK(plan.shortfall[1].at("surface too oblique") == 1);
+    CHECK(plan.perPiece[2].empty());
+    CHECK(plan.shortfall[2].count("no lattice axis of a ball meets this piece") == 1);
+    // No two chosen prisms come closer than twice their radius.
+    std::vector<Tenon> all;
+    for (const auto& list : plan.perPiece) all.insert(all.end(), list.begin(), list.end());
+    for (size_t i = 0; i < all.size(); ++i)
+        for (size_t j = i + 1; j < all.size(); ++j) {
+            const double d2 = zome::segmentSegmentDistanceSq(all[i].pointAt(all[i].shoulderMm), all[i].pointAt(all[i].endMm),
+                                                             all[j].pointAt(all[j].shoulderMm), all[j].pointAt(all[j].endMm));
+            CHECK(std::sqrt(d2) >= 2 * bodyRadiusMm(o));
+        }
+    // maxPerPiece 0: none at all.
+    TenonOptions none = o;
+    none.minPerPiece = 0;
+    none.maxPerPiece = 0;
+    for (const auto& list : chooseTenons(candidates, 3, none).perPiece) CHECK(list.empty());
+}
+
+TEST_CASE("tenons: a rotated frame rotates the axes and the peg") {
+    const double c = std::cos(0.35), s = std::sin(0.35);
+    Transform4d rot;
+    rot.m = {c, -s, 0, 5, s, c, 0, -3, 0, 0, 1, 2, 0, 0, 0, 1};
+    auto probe = sphereProbe(30, 40);
+    auto centred = probe;  // the shell is centred on the ball, which sits at (5, −3, 2) in the grid
+    centred.signedDistanceMm = [&](const Vec3d& x) { return probe.signedDistanceMm(sub(x, {5, -3, 2})); };
+    centred.pieceAt = [&](const Vec3d& x) { return probe.pieceAt(sub(x, {5, -3, 2})); };
+    TenonOptions o;
+    for (const TenonCandidate& cand : findTenonCandidates(oneBall(), rot, centred, o)) {
+        CHECK(cand.rejection.empty());
+        const Vec3d expected = applyLinear(rot, zome::holeDirection(cand.tenon.hole));
+        for (int a = 0; a < 3; ++a) CHECK(cand.tenon.axisGrid[size_t(a)] == doctest::Approx(expected[size_t(a)]));
+        const Vec3d longSide = applyLinear(rot, pegLongSideFrame(cand.tenon.hole));
+        for (int a = 0; a < 3; ++a) CHECK(cand.tenon.longSideGrid[size_t(a)] == doctest::Approx(longSide[size_t(a)]));
+        CHECK(cand.tenon.baseMm == doctest::Approx(30).epsilon(1e-6));
+    }
+}
+
+TEST_CASE("orientation: the largest cut face goes down, turned to fit the bed") {
+    // A 60 × 40 × 150 mm box; "cut" faces: x = 60 (40 × 150 mm²) and z = 0 (60 × 40 mm²).
+    const TriMesh box = zomefab::test::makeBox({0, 0, 0}, {60, 40, 150});
+    std::vector<CutFace> planes = {{{1, 0, 0}, -60, 0}, {{0, 0, -1}, 0, 0}, {{0, 1, 0}, -500, 0}};
+    const std::vector<CutFace> faces = measureCutFaces(box, planes, 1e-3);
+    REQUIRE(faces.size() == 2);
+    CHECK(faces[0].outwardNormal == Vec3d{1, 0, 0});
+    CHECK(faces[0].areaMm2 == doctest::Approx(40 * 150));
+    CHECK(faces[1].areaMm2 == doctest::Approx(60 * 40));
+    std::vector<Vec3d> points;
+    for (const Vec3f& p : box.positions) points.push_back(toD(p));
+    const PrintOrientation o = orientForPrinter(points, faces, {200, 200, 200});
+    CHECK(o.fits);
+    CHECK(o.isCutFaceDown);
+    CHECK(o.downNormal == Vec3d{1, 0, 0});
+    const Vec3d down = applyLinear(o.transformMm, {1, 0, 0});
+    CHECK(down[2] == doctest::Approx(-1));
+    CHECK(o.extentsMm[2] == doctest::Approx(60));
+    // On the bed, centred.
+    Box3d placed;
+    for (const Vec3d& p : points) placed.expand(o.transformMm.apply(p));
+    CHECK(placed.min[2] == doctest::Approx(0).epsilon(1e-9));
+    CHECK(0.5 * (placed.min[0] + placed.max[0]) == doctest::Approx(100));
+    CHECK(0.5 * (placed.min[1] + placed.max[1]) == doctest::Approx(100));
+
+    // The largest face down needs a 150 mm bed side (more than a 100 mm bed's diagonal allows
+    // for a 40 mm width): the next face is used.
+    const PrintOrientation second = orientForPrinter(points, faces, {100, 100, 160});
+    CHECK(second.fits);
+    CHECK(second.isCutFaceDown);
+    CHECK(second.downNormal == Vec3d{0, 0, -1});
+    CHECK(second.extentsMm[2] == doctest::Approx(150));
+    const PrintOrientation flat = orientForPrinter(points, faces, {250, 250, 45});
+    CHECK(flat.fits);
+    CHECK(!flat.isCutFaceDown);  // neither cut face fits: lying on a 40 mm side
+    CHECK(flat.extentsMm[2] <= 45);
+}
+
+TEST_CASE("orientation: a long piece fits diagonally; one too large fits nowhere") {
+    const TriMesh rod = zomefab::test::makeBox({0, 0, 0}, {250, 20, 20});
+    std::vector<Vec3d> points;
+    for (const Vec3f& p : rod.positions) points.push_back(toD(p));
+    const PrintOrientation o = orientForPrinter(points, {}, {200, 200, 200});
+    CHECK(o.fits);
+    CHECK(o.extentsMm[0] <= 200 + 1e-9);
+    CHECK(o.extentsMm[1] <= 200 + 1e-9);
+    const TriMesh big = zomefab::test::makeBox({0, 0, 0}, {300, 300, 300});
+    points.clear();
+    for (const Vec3f& p : big.positions) points.push_back(toD(p));
+    const PrintOrientation none = orientForPrinter(points, {}, {200, 200, 200});
+    CHECK(!none.fits);
+    CHECK(none.ratio > 1);
+}
+
+TEST_CASE("label: seven-segment strokes, an underline, centred") {
+    LabelOptions o;
+    const auto eight = labelStrokes("8", o);
+    CHECK(eight.size() == 8);  // 7 segments + underline
+    const auto one = labelStrokes("1", o);
+    CHECK(one.size() == 3);
+    const Vec3d size = labelSizeMm("12", o);
+    Box3d box;
+    for (const Stroke& s : labelStrokes("12", o)) {
+        box.expand({s.centerX - s.halfWidth, s.centerY - s.halfHeight, 0});
+        box.expand({s.centerX + s.halfWidth, s.centerY + s.halfHeight, 0});
+    }
+    CHECK(box.max[0] - box.min[0] == doctest::Approx(size[0]));
+    CHECK(box.max[1] - box.min[1] == doctest::Approx(size[1]));
+    CHECK(box.min[0] == doctest::Approx(-box.max[0]));
+    CHECK(box.min[1] == doctest::Approx(-box.max[1]));
+    CHECK_THROWS_AS(labelStrokes("A", o), Error);
+
+    // The engraving solid: inside a stroke from depth below to above the surface.
+    PieceLabel label{"1", {0, 0, 0}, {0, 0, 1}, {0, 1, 0}, size[0], size[1]};
+    const Stroke& s = one[0];
+    CHECK(labelSignedDistanceMm(label, one, o, {s.centerX, s.centerY, -0.5 * o.depthMm}) < 0);
+    CHECK(labelSignedDistanceMm(label, one, o, {s.centerX, s.centerY, -o.depthMm - 0.3}) == doctest::Approx(0.3));
+    // Readable from the cavity (+z): the right side of the text is +x = up × normal.
+    const auto two = labelStrokes("2", o);  // "2" has its upper vertical on the right
+    bool hasUpperRight = false;
+    for (const Stroke& st : two)
+        if (st.halfHeight > st.halfWidth && st.centerX > 0 && st.centerY > 0) hasUpperRight = true;
+    CHECK(hasUpperRight);
+}
+
+TEST_CASE("3mf: a deterministic OPC zip with the model in millimetres") {
+    const TriMesh a = zomefab::test::makeBox({0, 0, 0}, {10, 20, 30});
+    const TriMesh b = zomefab::test::makeBox({-5, -5, 0}, {5, 5, 5});
+    const std::vector<ThreeMfObject> objects = {{"piece-00", &a, Transform4d::identity()},
+                                                {"piece<01>", &b, Transform4d::scaleTranslate(1, {210, 0, 0})}};
+    const std::string bytes = threeMfBytes(objects, "zomefab test");
+    CHECK(bytes == threeMfBytes(objects, "zomefab test"));
+    const auto entries = unzip(bytes);
+    REQUIRE(entries.size() == 3);
+    REQUIRE(entries.count("[Content_Types].xml"));
+    REQUIRE(entries.count("_rels/.rels"));
+    REQUIRE(entries.count("3D/3dmodel.model"));
+    CHECK(entries.at("_rels/.rels").find("Target=\"/3D/3dmodel.model\"") != std::string::npos);
+    const std::string& model = entries.at("3D/3dmodel.model");
+    CHECK(model.find("unit=\"millimeter\"") != std::string::npos);
+    CHECK(countOf(model, "<object ") == 2);
+    CHECK(countOf(model, "<vertex ") == a.positions.size() + b.positions.size());
+    CHECK(countOf(model, "<triangle ") == a.triangles.size() + b.triangles.size());
+    CHECK(model.find("name=\"piece&lt;01&gt;\"") != std::string::npos);
+    CHECK(model.find("transform=\"1 0 0 0 1 0 0 0 1 210 0 0\"") != std::string::npos);
+    CHECK(model.find("<vertex x=\"10\" y=\"20\" z=\"30\"/>") != std::string::npos);
+    CHECK(bytes.size() < model.size());  // deflated
+
+    const std::vector<ThreeMfObject> none = {{"empty", nullptr, Transform4d::identity()}};
+    CHECK_THROWS_AS(threeMfBytes(none, "x"), Error);
+}
+
+TEST_CASE("zip: stored entries when deflate does not help") {
+    const std::string zip = zipArchive({{"a.bin", "x"}, {"b.txt", std::string(1000, 'a')}});
+    const auto entries = unzip(zip);
+    CHECK(entries.at("a.bin") == "x");
+    CHECK(entries.at("b.txt") == std::string(1000, 'a'));
+    CHECK(readU16(zip, 8) == 0);  // the 1-byte entry is stored
+}

@@ -1,0 +1,111 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "pieces_fixtures.h"
+
+#include <cmath>
+
+#include "test_util.h"
+#include "zomefab/core/run_context.h"
+#include "zomefab/pieces/detail/vec.h"
+#include "zomefab/zome/golden.h"
+
+namespace zomefab::pieces::test {
+
+using namespace detail;
+
+sdf::LevelSet makeSphereShell(const Vec3d& c, double r, double t, double voxel) {
+    sdf::MeshToLevelSetOptions o;
+    o.voxelMm = voxel;
+    o.interiorBandMm = t;
+    const TriMesh sphere = zomefab::test::makeSphere(c, r, 96, 192);
+    const sdf::LevelSet object = sdf::meshToLevelSet(sphere, o, RunContext::silent());
+    return sdf::makeShell(object, {t}, RunContext::silent());
+}
+
+zome::Structure makeCubeLattice(double maxRadiusMm) {
+    zome::Structure s;
+    const double b0 = s.scale().b0Mm;
+    const int n = int(std::floor(maxRadiusMm / b0));
+    const zome::Golden step(2, 2);  // B0 = 2 + 2φ units
+    for (int i = -n; i <= n; ++i)
+        for (int j = -n; j <= n; ++j)
+            for (int k = -n; k <= n; ++k)
+                if (std::sqrt(double(i * i + j * j + k * k)) * b0 <= maxRadiusMm)
+                    s.addBall(zome::GoldenVector3(step * zome::Golden(i), step * zome::Golden(j), step * zome::Golden(k)));
+    for (zome::BallId a : s.ballIds())
+        for (int hole : {0, 1, 2}) {
+            const zome::GoldenVector3 end = s.ball(a).position + zome::strutVector(hole, 0);
+            if (s.findBall(end) != zome::kNoId) s.addStrut(a, hole, 0);
+        }
+    return s;
+}
+
+CellModel quadrantCells(double x, double z) {
+    CellModel c;
+    for (double sx : {1.0, -1.0})
+        for (double sz : {1.0, -1.0}) {
+            c.w.push_back({sx, 0, sz});
+            c.b.push_back(-sx * x - sz * z);
+        }
+    return c;
+}
+
+CellModel halfSpaceCells(const Vec3d& n, double d) {
+    CellModel c;
+    c.w = {n, scale(n, -1.0)};
+    c.b = {-d, d};
+    return c;
+}
+
+std::vector<PieceRequest> requestPerCell(const CellModel& cells) {
+    std::vector<PieceRequest> r(cells.cellCount());
+    for (size_t k = 0; k < r.size(); ++k) r[k].cells = {uint32_t(k)};
+    return r;
+}
+
+std::optional<double> firstHit(const TriMesh& m, const Vec3d& o, const Vec3d& d) {
+    std::optional<double> best;
+    for (const Triangle& t : m.triangles) {
+        const Vec3d a = toD(m.positions[t[0]]), b = toD(m.positions[t[1]]), c = toD(m.positions[t[2]]);
+        const Vec3d e1 = sub(b, a), e2 = sub(c, a);
+        const Vec3d p = cross(d, e2);
+        const double det = dot(e1, p);
+        if (std::abs(det) < 1e-14) continue;
+        const Vec3d s = sub(o, a);
+        const double u = dot(s, p) / det;
+        if (u < 0 || u > 1) continue;
+        const Vec3d q = cross(s, e1);
+        const double v = dot(d, q) / det;
+        if (v < 0 || u + v > 1) continue;
+        const double tt = dot(e2, q) / det;
+        if (tt > 0 && (!best || tt < *best)) best = tt;
+    }
+    return best;
+}
+
+bool isInsideMesh(const TriMesh& m, const Vec3d& o) {
+    const Vec3d d = normalized({0.5773, 0.5801, 0.5748});
+    size_t crossings = 0;
+    for (const Triangle& t : m.triangles) {
+        const Vec3d a = toD(m.positions[t[0]]), b = toD(m.positions[t[1]]), c = toD(m.positions[t[2]]);
+        const Vec3d e1 = sub(b, a), e2 = sub(c, a);
+        const Vec3d p = cross(d, e2);
+        const double det = dot(e1, p);
+        if (std::abs(det) < 1e-14) continue;
+        const Vec3d s = sub(o, a);
+        const double u = dot(s, p) / det;
+        if (u < 0 || u > 1) continue;
+        const Vec3d q = cross(s, e1);
+        const double v = dot(d, q) / det;
+        if (v < 0 || u + v > 1) continue;
+        if (dot(e2, q) / det > 0) ++crossings;
+    }
+    return crossings % 2 == 1;
+}
+
+TriMesh gridMesh(const Piece& piece) {
+    TriMesh m = piece.mesh;
+    transformInPlace(m, affineInverse(piece.gridToPrintMm));
+    return m;
+}
+
+}  // namespace zomefab::pieces::test

@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file Fixtures for the pieces tests: a spherical shell level set, a B0 cube-lattice frame inside
+/// it, argmax cells from axis planes, and mesh queries (point inside, ray hits).
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "zomefab/core/transform.h"
+#include "zomefab/core/tri_mesh.h"
+#include "zomefab/pieces/pieces.h"
+#include "zomefab/sdf/level_set.h"
+#include "zomefab/zome/structure.h"
+
+namespace zomefab::pieces::test {
+
+/// The shell {R − T ≤ |x − c| ≤ R} as a level set (a UV sphere mesh through meshToLevelSet and
+/// makeShell), at @p voxelMm.
+sdf::LevelSet makeSphereShell(const Vec3d& centerMm, double radiusMm, double shellMm, double voxelMm);
+
+/// Balls on the B0 cube lattice (exact (2+2φ)·(i, j, k) units, b0 = 47.3 mm) whose centre lies
+/// within @p maxRadiusMm of the origin, joined by B0 struts to their lattice neighbours.
+zome::Structure makeCubeLattice(double maxRadiusMm);
+
+/// Argmax cells cutting space along x = @p xMm and z = @p zMm (4 cells, frame mm): for signs
+/// (sx, sz) ∈ {±1}², w = (sx, 0, sz), b = −sx·x − sz·z.
+CellModel quadrantCells(double xMm, double zMm);
+/// Two cells cut by the plane n·x = d (n need not be unit): {n·x ≥ d} is cell 0.
+CellModel halfSpaceCells(const Vec3d& n, double d);
+/// One request per cell.
+std::vector<PieceRequest> requestPerCell(const CellModel& cells);
+
+/// Is @p p inside the closed mesh? (ray parity along a fixed skew direction)
+bool isInsideMesh(const TriMesh& mesh, const Vec3d& p);
+/// Distance along the ray @p origin + t·@p dir (t > 0) to the first triangle, if any.
+std::optional<double> firstHit(const TriMesh& mesh, const Vec3d& origin, const Vec3d& dir);
+
+/// @p piece's mesh in the shell grid's mm (undoes the print orientation).
+TriMesh gridMesh(const Piece& piece);
+
+}  // namespace zomefab::pieces::test

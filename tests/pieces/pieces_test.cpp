@@ -1,0 +1,425 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// makePieces end to end on a 200 mm spherical shell with a B0 cube lattice inside: the pieces'
+// union is the shell, every mesh is closed and fits the printer, tenons are exact and clear of the
+// frame, slivers are merged, the number is engraved, and results do not depend on the threads.
+#include <doctest/doctest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+
+#include "pieces_fixtures.h"
+#include "test_util.h"
+#include "zomefab/core/error.h"
+#include "zomefab/io/file_io.h"
+#include "zomefab/io/mesh_io.h"
+#include "zomefab/mesh/mesh_check.h"
+#include "zomefab/pieces/detail/vec.h"
+#include "zomefab/pieces/pieces.h"
+#include "zomefab/pieces/pieces_io.h"
+#include "zomefab/zome/zome_system.h"
+
+using namespace zomefab;
+using namespace zomefab::pieces;
+using namespace zomefab::pieces::detail;
+using namespace zomefab::pieces::test;
+
+namespace {
+
+constexpr double kRadius = 100.0, kShell = 8.0, kVoxel = 1.0;
+
+/// The shell, built once for all cases (≈ 1 s).
+const sdf::LevelSet& shell() {
+    static const sdf::LevelSet s = makeSphereShell({0, 0, 0}, kRadius, kShell, kVoxel);
+    return s;
+}
+
+/// Lattice balls whose surface stays 3 mm clear of the inner wall.
+const zome::Structure& frame() {
+    static const zome::Structure s = makeCubeLattice(kRadius - kShell - 8.85 - 3.0);
+    return s;
+}
+
+PiecesOptions plainOptions() {
+    PiecesOptions o;
+    o.tenons.maxPerPiece = 0;
+    o.tenons.minPerPiece = 0;
+    o.label.isEnabled = false;
+    return o;
+}
+
+double meshVolume(const TriMesh& m) { return mesh::checkMesh(m).volume; }
+
+/// Shell mesh volume at the same voxel (the reference for the union).
+double shellVolume() {
+    static const double v = meshVolume(sdf::levelSetToMesh(shell(), {}, RunContext::silent()));
+    return v;
+}
+
+void checkClosedAndFits(const Pieces& result) {
+    for (const Piece& p : result.pieces) {
+        INFO("piece " << p.id);
+        const mesh::MeshReport r = mesh::checkMesh(p.mesh);
+        CHECK(r.boundaryEdges == 0);
+        CHECK(r.nonManifoldEdges == 0);
+        CHECK(r.inconsistentEdges == 0);
+        CHECK(r.degenerateTriangles == 0);
+        CHECK(r.volume > 0);
+        CHECK(p.volumeMm3 == doctest::Approx(r.volume));
+        for (int a = 0; a < 3; ++a) {
+            CHECK(r.bounds.min[size_t(a)] >= -1e-3);
+            CHECK(r.bounds.max[size_t(a)] <= result.printerMm[size_t(a)] + 1e-3);
+        }
+        CHECK(r.bounds.min[2] == doctest::Approx(0).epsilon(1e-3));
+        // A cut face down means flat triangles on the bed facing down.
+        double bedArea = 0;
+        for (const Triangle& t : p.mesh.triangles) {
+            const Vec3d a = toD(p.mesh.positions[t[0]]), b = toD(p.mesh.positions[t[1]]), c = toD(p.mesh.positions[t[2]]);
+            if (std::max({a[2], b[2], c[2]}) > 1e-3) continue;
+            const Vec3d n = cross(sub(b, a), sub(c, a));
+            if (n[2] < 0) bedArea += 0.5 * norm(n);
+        }
+        if (p.isCutFaceDown) CHECK(bedArea > 50.0);
+    }
+}
+
+}  // namespace
+
+TEST_CASE("pieces: the union of the pieces is the shell (volume and sampled points)") {
+    const CellModel cells = quadrantCells(-15.3, 20.4);
+    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells),
+                                     plainOptions(), RunContext::silent());
+    REQUIRE(result.pieces.size() == 4);
+    checkClosedAndFits(result);
+    double total = 0;
+    for (const Piece& p : result.pieces) {
+        total += p.volumeMm3;
+        CHECK(p.isCutFaceDown);
+        CHECK(p.cells.size() == 1);
+        CHECK(p.requests == p.cells);
+    }
+    CHECK(total == doctest::Approx(shellVolume()).epsilon(0.01));
+    CHECK(result.shellVolumeMm3 == doctest::Approx(shellVolume()).epsilon(0.01));
+    // Neighbours: the quadrants x ≶ −15.3 and z ≶ 20.4; diagonal ones touch only along a line.
+    for (const Piece& p : result.pieces) CHECK(p.neighbors.size() == 2);
+
+    // Sampled points: inside the shell ⇒ in exactly one piece; outside ⇒ in none. Points within
+    // a voxel of a surface or a cut plane are skipped (the mesh is accurate to a fraction of one).
+    std::vector<TriMesh> meshes;
+    for (const Piece& p : result.pieces) meshes.push_back(gridMesh(p));
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(-kRadius - 5, kRadius + 5);
+    int inside = 0, outside = 0;
+    for (int i = 0; i < 600; ++i) {
+        const Vec3d x{u(rng), u(rng), u(rng)};
+        const double r = norm(x);
+        if (std::abs(r - kRadius) < kVoxel || std::abs(r - (kRadius - kShell)) < kVoxel) continue;
+        if (std::abs(x[0] + 15.3) < kVoxel || std::abs(x[2] - 20.4) < kVoxel) continue;
+        const bool isInShell = r < kRadius && r > kRadius - kShell;
+        int count = 0;
+        for (const TriMesh& m : meshes) count += isInsideMesh(m, x) ? 1 : 0;
+        INFO("point " << x[0] << " " << x[1] << " " << x[2]);
+        CHECK(count == (isInShell ? 1 : 0));
+        (isInShell ? inside : outside) += 1;
+    }
+    CHECK(inside > 10);
+    CHECK(outside > 300);
+}
+
+TEST_CASE("pieces: tenons use free lattice holes, end at the ball's face and clear the frame") {
+    const CellModel cells = quadrantCells(-15.3, 20.4);
+    PiecesOptions o;
+    o.label.isEnabled = false;
+    o.tenons.maxTiltDeg = 35;
+    const Pieces result =
+        makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells), o, RunContext::silent());
+    checkClosedAndFits(result);
+    const zome::Structure& f = frame();
+    const double ballRadius = f.scale().ballRadiusMm();
+    std::map<std::pair<zome::BallId, int>, int> used;
+    size_t total = 0;
+    for (const Piece& p : result.pieces) {
+        INFO("piece " << p.id);
+        CHECK(p.tenons.size() >= 1);
+        if (p.tenons.size() < 2) CHECK(!p.tenonShortfall.empty());
+        const TriMesh m = gridMesh(p);
+        for (const Tenon& t : p.tenons) {
+            ++total;
+            CHECK(++used[{t.ball, t.hole}] == 1);
+            CHECK((t.hole == 0 || t.hole == 1 || t.hole == 2 || t.hole == 15 || t.hole == 16 || t.hole == 17));
+            CHECK(t.axisFrame == zome::holeDirection(t.hole));  // exact table direction
+            CHECK(f.isHoleFree(t.ball, t.hole));
+            CHECK(t.piece == p.id);
+            const Vec3d c = f.ball(t.ball).positionMm;  // frame = grid here
+            CHECK(norm(sub(t.pointAt(t.shoulderMm), c)) == doctest::Approx(ballRadius).epsilon(1e-9));
+            CHECK(t.tiltDeg <= 35.0);
+            CHECK(t.lengthMm() <= o.tenons.maxLengthMm);
+            // The mesh: along the axis the first surface is the peg's tip; beside the peg (inside
+            // the prism's section, across the peg's short side where the shoulder is widest) it is
+            // the shoulder, on the ball's blue face within 0.5 mm.
+            const auto tip = firstHit(m, c, t.axisGrid);
+            REQUIRE(tip);
+            CHECK(std::abs(*tip - (ballRadius - o.tenons.pegDepthMm)) < 0.5);
+            const double beside = 0.5 * (0.5 * pegShortMm(o.tenons) + 0.5 * o.tenons.bodyWidthMm);
+            const auto shoulder = firstHit(m, madd(c, beside, cross(t.axisGrid, t.longSideGrid)), t.axisGrid);
+            REQUIRE(shoulder);
+            CHECK(std::abs(*shoulder - ballRadius) < 0.5);
+            // The peg's section: across the long side the surface is at half the peg's length.
+            const Vec3d mid = t.pointAt(ballRadius - 0.5 * o.tenons.pegDepthMm);
+            const auto across = firstHit(m, madd(mid, -20.0, t.longSideGrid), t.longSideGrid);
+            REQUIRE(across);
+            CHECK(std::abs((20.0 - *across) - 0.5 * pegLongMm(o.tenons)) < 0.25);
+        }
+        // No vertex of the piece inside a strut's capsule or another ball.
+        for (const Vec3f& v : m.positions) {
+            const Vec3d x = toD(v);
+            for (zome::StrutId s : f.strutIds()) {
+                const zome::Strut& strut = f.strut(s);
+                CHECK(zome::pointSegmentDistanceSq(x, strut.startMm, strut.endMm) >=
+                      std::pow(f.scale().strutRadiusMm(strut.color) - 0.05, 2));
+            }
+            for (zome::BallId b : f.ballIds()) {
+                const double d = norm(sub(x, f.ball(b).positionMm));
+                if (d >= ballRadius) continue;
+                // Only a peg may enter a ball: within the peg's box of a tenon into that ball.
+                bool isPeg = false;
+                for (const Tenon& t : p.tenons)
+                    if (t.ball == b && tenonSignedDistanceMm(t, o.tenons, x) < 0.5 && dot(sub(x, t.ballCenterGridMm), t.axisGrid) > 0)
+                        isPeg = true;
+                CHECK(isPeg);
+            }
+        }
+    }
+    CHECK(total >= 6);
+}
+
+TEST_CASE("pieces: slivers are merged into a neighbour, never dropped") {
+    // A plane 1.5 mm inside the outer surface cuts off a ~700 mm³ cap of the wall.
+    const CellModel cells = halfSpaceCells({1, 0, 0}, kRadius - 1.5);
+    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells),
+                                     plainOptions(), RunContext::silent());
+    REQUIRE(result.pieces.size() == 1);
+    CHECK(result.sliversMerged == 1);
+    CHECK(result.pieces[0].sliversMerged == 1);
+    CHECK(result.pieces[0].cells == std::vector<uint32_t>{0, 1});
+    checkClosedAndFits(result);
+    CHECK(result.pieces[0].volumeMm3 == doctest::Approx(shellVolume()).epsilon(0.01));
+
+    // With no minimum the cap is a piece of its own.
+    PiecesOptions keep = plainOptions();
+    keep.minPieceVolumeMm3 = 0;
+    const Pieces two = makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells), keep,
+                                  RunContext::silent());
+    REQUIRE(two.pieces.size() == 2);
+    CHECK(two.pieces[0].volumeMm3 + two.pieces[1].volumeMm3 == doctest::Approx(shellVolume()).epsilon(0.01));
+    CHECK(std::min(two.pieces[0].volumeMm3, two.pieces[1].volumeMm3) < 1500);
+}
+
+TEST_CASE("pieces: a cell shared by two requests and a cell no request names") {
+    // Cells: 0 = x ≥ 0 and 1 = x < 0. Both requests name cell 0 (its shell part is connected, so it
+    // goes whole to the request whose surface box holds most of it); no request names cell 1,
+    // whose shell part joins its neighbour, whatever its size.
+    const CellModel cells = halfSpaceCells({1, 0, 0}, 0.0);
+    std::vector<PieceRequest> requests(2);
+    requests[0].cells = {0};
+    requests[0].boundsMm.expand({50, 50, 50});
+    requests[0].boundsMm.expand({60, 60, 60});
+    requests[1].cells = {0};
+    requests[1].boundsMm.expand({0, -100, -100});
+    requests[1].boundsMm.expand({100, 100, 100});
+    RunContext context;
+    PiecesOptions o = plainOptions();
+    o.printerMm = {250, 250, 250};
+    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells, requests, o, context);
+    REQUIRE(result.pieces.size() == 1);
+    CHECK(result.pieces[0].requests == std::vector<uint32_t>{1});
+    CHECK(result.pieces[0].cells == std::vector<uint32_t>{0, 1});
+    CHECK(result.sliversMerged == 0);
+    CHECK(result.outsideCellsVolumeMm3 == doctest::Approx(0.5 * shellVolume()).epsilon(0.02));
+    CHECK(result.pieces[0].volumeMm3 == doctest::Approx(shellVolume()).epsilon(0.01));
+    REQUIRE(!context.warnings().empty());
+    CHECK(context.warnings()[0].find("no partition piece names") != std::string::npos);
+    checkClosedAndFits(result);
+}
+
+TEST_CASE("pieces: a piece larger than the printer is an error of the partition") {
+    const CellModel cells = halfSpaceCells({0, 0, 1}, 0.0);  // two 200 × 200 × 100 mm halves
+    PiecesOptions o = plainOptions();
+    o.printerMm = {120, 120, 120};
+    try {
+        makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells), o, RunContext::silent());
+        FAIL("no error");
+    } catch (const Error& e) {
+        CHECK(e.code() == ErrorCode::ProcessingFailed);
+        CHECK(std::string(e.what()).find("in no orientation") != std::string::npos);
+        CHECK(std::string(e.what()).find("partition") != std::string::npos);
+    }
+}
+
+TEST_CASE("pieces: bad inputs and options") {
+    const CellModel cells = halfSpaceCells({0, 0, 1}, 0.0);
+    auto codeOf = [&](const CellModel& c, const std::vector<PieceRequest>& r, const PiecesOptions& o,
+                      const Transform4d& t = Transform4d::identity()) {
+        try {
+            makePieces(shell(), frame(), t, c, r, o, RunContext::silent());
+        } catch (const Error& e) {
+            return int(e.code());
+        }
+        return -1;
+    };
+    std::vector<PieceRequest> bad(1);
+    bad[0].cells = {5};
+    CHECK(codeOf(cells, bad, plainOptions()) == int(ErrorCode::InvalidInput));
+    CHECK(codeOf(cells, requestPerCell(cells), plainOptions(), Transform4d::scaleTranslate(2.0, {0, 0, 0})) ==
+          int(ErrorCode::InvalidInput));
+    CellModel empty;
+    CHECK(codeOf(empty, {}, plainOptions()) == int(ErrorCode::InvalidInput));
+    PiecesOptions o = plainOptions();
+    o.adaptivity = 1.5;
+    CHECK(codeOf(cells, requestPerCell(cells), o) == int(ErrorCode::Usage));
+    // Tenon pegs need a fine enough voxel: a 2 mm shell is too coarse.
+    const sdf::LevelSet coarse = makeSphereShell({0, 0, 0}, 60.0, 8.0, 2.0);
+    PiecesOptions withTenons;
+    try {
+        makePieces(coarse, frame(), Transform4d::identity(), cells, requestPerCell(cells), withTenons, RunContext::silent());
+        FAIL("no error");
+    } catch (const Error& e) {
+        CHECK(e.code() == ErrorCode::Usage);
+        CHECK(std::string(e.what()).find("voxel") != std::string::npos);
+    }
+}
+
+TEST_CASE("pieces: the engraved number is cut into the inner surface") {
+    const CellModel cells = halfSpaceCells({0, 0, 1}, 10.0);
+    PiecesOptions o;
+    o.tenons.maxTiltDeg = 35;
+    const Pieces result =
+        makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells), o, RunContext::silent());
+    checkClosedAndFits(result);
+    size_t labelled = 0;
+    for (const Piece& p : result.pieces) {
+        if (!p.label) {
+            CHECK(!p.labelNote.empty());
+            continue;
+        }
+        ++labelled;
+        const PieceLabel& l = *p.label;
+        CHECK(l.text == std::to_string(p.id));
+        // On the inner surface, facing the cavity (towards the centre).
+        CHECK(norm(l.centerGridMm) == doctest::Approx(kRadius - kShell).epsilon(0.01));
+        CHECK(dot(l.normalGrid, normalized(l.centerGridMm)) < -0.9);
+        const TriMesh m = gridMesh(p);
+        const auto strokes = labelStrokes(l.text, o.label);
+        const Vec3d right = cross(l.upGrid, l.normalGrid);
+        auto at = [&](double x, double y, double z) {
+            return madd(madd(madd(l.centerGridMm, x, right), y, l.upGrid), z, l.normalGrid);
+        };
+        // Half the depth under the underline: engraved (outside the piece); beside the label: wall.
+        const Stroke& underline = strokes.back();
+        CHECK(!isInsideMesh(m, at(underline.centerX, underline.centerY, -0.5 * o.label.depthMm)));
+        CHECK(isInsideMesh(m, at(0.5 * l.widthMm + 2.0, 0, -0.5 * o.label.depthMm)));
+        CHECK(isInsideMesh(m, at(underline.centerX, underline.centerY, -o.label.depthMm - 0.8)));
+    }
+    CHECK(labelled >= 1);
+}
+
+TEST_CASE("pieces: a frame rotated about the vertical and shifted") {
+    const double a = 0.3;
+    Transform4d frameToGrid;
+    frameToGrid.m = {std::cos(a), -std::sin(a), 0, 4.0, std::sin(a), std::cos(a), 0, -6.0, 0, 0, 1, 3.0, 0, 0, 0, 1};
+    // The shell stays centred at the origin of the grid; the frame (made around its own origin)
+    // is placed by frameToGrid, so keep it well inside: a smaller lattice.
+    const zome::Structure small = makeCubeLattice(60.0);
+    const CellModel cells = quadrantCells(-15.3, 20.4);  // in the frame's mm
+    PiecesOptions o;
+    o.label.isEnabled = false;
+    o.tenons.maxTiltDeg = 35;
+    const Pieces result = makePieces(shell(), small, frameToGrid, cells, requestPerCell(cells), o, RunContext::silent());
+    REQUIRE(result.pieces.size() == 4);
+    checkClosedAndFits(result);
+    size_t total = 0;
+    for (const Piece& p : result.pieces)
+        for (const Tenon& t : p.tenons) {
+            ++total;
+            const Vec3d expected = applyLinear(frameToGrid, zome::holeDirection(t.hole));
+            for (int k = 0; k < 3; ++k) CHECK(t.axisGrid[size_t(k)] == doctest::Approx(expected[size_t(k)]));
+            const Vec3d c = frameToGrid.apply(small.ball(t.ball).positionMm);
+            CHECK(norm(sub(t.ballCenterGridMm, c)) < 1e-9);
+            const auto tip = firstHit(gridMesh(p), c, t.axisGrid);
+            REQUIRE(tip);
+            CHECK(std::abs(*tip - t.pegTipMm) < 0.5);
+        }
+    CHECK(total >= 4);
+    // The cut planes are the frame's planes mapped into the grid: a sampled point test.
+    std::vector<TriMesh> meshes;
+    for (const Piece& p : result.pieces) meshes.push_back(gridMesh(p));
+    const Transform4d gridToFrame = affineInverse(frameToGrid);
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-kRadius, kRadius);
+    for (int i = 0; i < 200; ++i) {
+        const Vec3d x{u(rng), u(rng), u(rng)};
+        const double r = norm(x);
+        if (!(r < kRadius - kVoxel && r > kRadius - kShell + kVoxel)) continue;
+        const Vec3d xf = gridToFrame.apply(x);
+        if (std::abs(xf[0] + 15.3) < 2 * kVoxel || std::abs(xf[2] - 20.4) < 2 * kVoxel) continue;
+        const size_t expected = (xf[0] > -15.3 ? 0 : 2) + (xf[2] > 20.4 ? 0 : 1);
+        bool isNearTenon = false;
+        for (const Piece& p : result.pieces)
+            for (const Tenon& t : p.tenons)
+                if (tenonSignedDistanceMm(t, o.tenons, x) < 1.0) isNearTenon = true;
+        if (isNearTenon) continue;
+        for (size_t k = 0; k < meshes.size(); ++k) {
+            INFO("point " << x[0] << " " << x[1] << " " << x[2] << ", piece " << k);
+            CHECK(isInsideMesh(meshes[k], x) == (result.pieces[k].cells[0] == expected));
+        }
+    }
+}
+
+TEST_CASE("pieces: the same result with 1 and 2 threads, and the written files") {
+    const CellModel cells = quadrantCells(-15.3, 20.4);
+    PiecesOptions o;
+    o.tenons.maxTiltDeg = 35;
+    auto run = [&](int threads) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+        return makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells), o, RunContext::silent());
+    };
+    const Pieces one = run(1), two = run(2);
+    REQUIRE(one.pieces.size() == two.pieces.size());
+    for (size_t i = 0; i < one.pieces.size(); ++i)
+        CHECK(serializeMesh(one.pieces[i].mesh, MeshFormat::Stl) == serializeMesh(two.pieces[i].mesh, MeshFormat::Stl));
+    const PiecesJsonInfo info{"shell.vdb", "frame.json", "partition.json"};
+    CHECK(piecesToJson(one, info).dump() == piecesToJson(two, info).dump());
+
+    zomefab::test::ScratchDir dir("zomefab-pieces");
+    const std::string out = dir.file("pieces");
+    writePieces(one, out, info);
+    const nlohmann::json j = nlohmann::json::parse(readInputBytes(out + "/pieces.json"));
+    CHECK(j["format"] == "zomefab.pieces");
+    CHECK(j["units"] == "mm");
+    REQUIRE(j["pieces"].size() == one.pieces.size());
+    for (size_t i = 0; i < one.pieces.size(); ++i) {
+        const nlohmann::json& p = j["pieces"][i];
+        CHECK(p["file"] == pieceFileName(one, i));
+        const TriMesh back = readMesh(out + "/" + p["file"].get<std::string>());
+        CHECK(back.triangles.size() == one.pieces[i].mesh.triangles.size());
+        CHECK(p["volume_mm3"].get<double>() == doctest::Approx(one.pieces[i].volumeMm3));
+        CHECK(p["tenons"].size() == one.pieces[i].tenons.size());
+        CHECK(p["orientation"]["transform_mm"].size() == 4);
+        for (const nlohmann::json& t : p["tenons"]) CHECK(t["length_mm"].get<double>() > 0);
+    }
+    CHECK(readInputBytes(out + "/pieces.3mf").substr(0, 4) == std::string("PK\x03\x04", 4));
+    // Written again over the earlier output: replaced (it holds a pieces.json).
+    writePieces(two, out, info);
+    CHECK(readInputBytes(out + "/pieces.json") == piecesToJson(two, info).dump(2) + "\n");
+    // A directory that is not ours is not replaced, and nothing is left behind.
+    const std::string foreign = dir.file("foreign");
+    std::filesystem::create_directory(foreign);
+    zomefab::test::writeBytes(foreign + "/keep.txt", "x");
+    CHECK_THROWS_AS(writePieces(one, foreign, info), Error);
+    CHECK(std::filesystem::exists(foreign + "/keep.txt"));
+    CHECK_THROWS_AS(writePieces(one, dir.file("no/such/parent"), info), Error);
+    size_t entries = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir.path())) entries += e.path().filename().string()[0] == '.';
+    CHECK(entries == 0);  // no staging directory left
+}
