@@ -3,11 +3,11 @@
 /// outermost balls (paper §5). MESH is in its own coordinates; the frame's transform_mm places it.
 /// Parse, read, call, write; the stage lives in lib/zomefab/partition (docs/partition.md).
 #include <cstdio>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "common/cli.h"
+#include "common/stage_options.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/transform.h"
 #include "zomefab/frame/outermost.h"
@@ -19,49 +19,6 @@
 
 using namespace zomefab;
 using nlohmann::json;
-
-namespace {
-
-/// "200x200x200" (mm) → sizes. @throw Error(Usage)
-Vec3d parsePrinter(const std::string& text) {
-    Vec3d v{};
-    char x1 = 0, x2 = 0, rest = 0;
-    std::istringstream in(text);
-    if (!(in >> v[0] >> x1 >> v[1] >> x2 >> v[2]) || (x1 != 'x' && x1 != 'X') || (x2 != 'x' && x2 != 'X') || (in >> rest))
-        throw Error(ErrorCode::Usage, "--printer-mm: expected WxDxH in mm, e.g. 200x200x200, got \"" + text + "\"");
-    return v;
-}
-
-/// "x,y,z,r" (mm) → sphere. @throw Error(Usage)
-partition::SalientSphere parseSphere(const std::string& text) {
-    partition::SalientSphere s;
-    char c1 = 0, c2 = 0, c3 = 0, rest = 0;
-    std::istringstream in(text);
-    if (!(in >> s.centerMm[0] >> c1 >> s.centerMm[1] >> c2 >> s.centerMm[2] >> c3 >> s.radiusMm) || c1 != ',' ||
-        c2 != ',' || c3 != ',' || (in >> rest))
-        throw Error(ErrorCode::Usage, "--salient: expected x,y,z,r in mm, got \"" + text + "\"");
-    return s;
-}
-
-/// A JSON list of face indices, or {"salient_faces": [...]}. @throw Error(InvalidInput) naming the file
-std::vector<uint32_t> readFaceList(const std::string& path, size_t faceCount) {
-    const std::string bytes = readInputBytes(path);
-    json j = json::parse(bytes, nullptr, false);
-    if (j.is_discarded()) throw Error(ErrorCode::InvalidInput, "invalid JSON", path);
-    if (j.is_object() && j.contains("salient_faces")) j = j["salient_faces"];
-    if (!j.is_array())
-        throw Error(ErrorCode::InvalidInput, "expected a list of face indices or {\"salient_faces\": [...]}", path);
-    std::vector<uint32_t> out;
-    for (const json& v : j) {
-        if (!v.is_number_unsigned() || v.get<uint64_t>() >= faceCount)
-            throw Error(ErrorCode::InvalidInput,
-                        "salient face " + v.dump() + " is not a face index below " + std::to_string(faceCount), path);
-        out.push_back(v.get<uint32_t>());
-    }
-    return out;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
     cli::Tool tool("zf-partition",
@@ -103,8 +60,8 @@ int main(int argc, char** argv) {
     tool.addFormatOption("--in-format", inFormat, {"stl", "obj", "ply", "gltf", "glb"}, "Mesh format (needed for -)");
 
     return tool.run(argc, argv, [&](json& report) {
-        opt.printerMm = parsePrinter(printer);
-        for (const std::string& s : spheres) opt.salientSpheres.push_back(parseSphere(s));
+        opt.printerMm = cli::parsePrinterMm(printer);
+        for (const std::string& s : spheres) opt.salientSpheres.push_back(cli::parseSalientSphere(s));
         opt.svm.useCrammerSinger = !oneVsRest;
         opt.seed = tool.common().seed;
         partition::checkPartitionOptions(opt);  // bad options fail before any input is read
@@ -122,7 +79,7 @@ int main(int argc, char** argv) {
             }
         }();
         transformInPlace(mesh, transformMm);
-        if (!salientFile.empty()) opt.salientFaceIndices = readFaceList(salientFile, mesh.triangles.size());
+        if (!salientFile.empty()) opt.salientFaceIndices = cli::readSalientFaceList(salientFile, mesh.triangles.size());
 
         const std::vector<zome::BallId> labels = frame::outermostBalls(frame);
         partition::PartitionResult r;

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # same_frame.sh ZF_FRAME OBJECT.vdb OUTDIR: the same seed gives a byte-identical FRAME.json with 1
 # and with 2 threads, the frame file carries transform_mm, and the report has both energies.
 set -eu

@@ -93,6 +93,32 @@ TEST_CASE("zf-partition: bunny in file coordinates, frame with transform_mm") {
     const TriMesh ply = readMesh(dir.file("p.ply"));
     CHECK(ply.triangles.size() == faces);
     CHECK(ply.positions[0][0] == doctest::Approx(bunny.mesh.positions[0][0]));
+
+    // The same salient faces as a PLY `salient` face property (mesh in file coordinates), plus a
+    // salient sphere around the highest point (frame mm).
+    TriMesh marked = readMesh(meshPath);
+    marked.salientFaces.assign(marked.triangles.size(), 0);
+    for (uint32_t f : salient) marked.salientFaces[f] = 1;
+    writeMesh(marked, dir.file("marked.ply"));
+    size_t top = 0;
+    for (size_t v = 0; v < bunny.mesh.positions.size(); ++v)
+        if (bunny.mesh.positions[v][2] > bunny.mesh.positions[top][2]) top = v;
+    const auto& q = bunny.mesh.positions[top];
+    std::ostringstream sphere;
+    sphere << q[0] << "," << q[1] << "," << q[2] << ",15";
+    REQUIRE(runTool(dir.file("marked.ply") + " " + framePath + " --printer-mm 150x150x150 -q -o " + dir.file("p3.json") +
+                        " --salient " + sphere.str(),
+                    dir.file("err3.txt")) == 0);
+    const json k = json::parse(readInputBytes(dir.file("p3.json")));
+    std::set<uint32_t> markedFaces(salient.begin(), salient.end());
+    size_t inSphere = 0;
+    for (const json& f : k["salient_faces"]) inSphere += markedFaces.count(f.get<uint32_t>()) ? 0 : 1;
+    CHECK(inSphere > 0);                                          // the sphere added faces
+    CHECK(k["salient_faces"].size() == markedFaces.size() + inSphere);  // and the PLY flags are all there
+    std::set<uint32_t> pieces;
+    for (uint32_t f : salient) pieces.insert(k["face_pieces"][f].get<uint32_t>());
+    CHECK(pieces.size() == 1);
+    CHECK(k["counts"]["salient_regions_crossed"] == 0);
 }
 
 TEST_CASE("zf-partition: bad inputs exit with the documented codes and write nothing") {

@@ -100,6 +100,26 @@ TEST_CASE("cost_report: hollow and solid cases against the octree baseline") {
     CHECK(md.find("| solid (100%) | ZomeFab |") != std::string::npos);
 }
 
+TEST_CASE("cost_report: a part the slicer fails on is estimated instead, with a warning") {
+    // /bin/false stands for a slicer that fails on everything.
+    const TriMesh object = makeBox({0, 0, 0}, {40, 40, 40});
+    const std::vector<TriMesh> pieces = {hollowCube(40, 6)};
+    CostOptions o;
+    o.source = EstimateSource::PrusaSlicer;
+    o.slicer.executable = "false";
+    std::vector<std::string> warnings;
+    RunContext context([&](LogLevel level, const std::string& m) { if (level == LogLevel::Warning) warnings.push_back(m); },
+                       nullptr);
+    const CostReport r = costReport(object, pieces, bunnyParts(), o, context);
+    CHECK(r.slicerFallbacks == std::vector<std::string>{"hollow piece 0 at 20%", "hollow baseline part 0 at 20%",
+                                                         "solid piece 0 at 100%", "solid baseline part 0 at 100%"});
+    REQUIRE(warnings.size() == 4);
+    CHECK(warnings[0].find("false failed on hollow piece 0 at 20%") != std::string::npos);
+    const CostReport model = costReport(object, pieces, bunnyParts());
+    CHECK(r.cases[0].zomefab.print.seconds == model.cases[0].zomefab.print.seconds);
+    CHECK(costReportToJson(r)["slicer_fallbacks"].size() == 4);
+}
+
 TEST_CASE("cost_report: filament options change cost and length, not time") {
     const SphereCase sphere;
     CostOptions cheap;

@@ -101,6 +101,32 @@ TEST_CASE("print_estimate: fitsPrinter tries the axis permutations") {
     CHECK_FALSE(fitsPrinter({150, 150, 150}, {100, 200, 200}));
 }
 
+TEST_CASE("print_estimate: parts are turned onto their largest flat face") {
+    // The lower half of a sphere has its cap on top and a pole at the bottom: turned over.
+    const TriMesh lower = clipByPlane(makeSphere({0, 0, 0}, 30, 31, 64), 2, 0.0, true);
+    const TriMesh turned = orientOnBed(lower, {200, 200, 200});
+    CHECK(isClosedOriented(turned));
+    CHECK(meshVolumeMm3(turned) == doctest::Approx(meshVolumeMm3(lower)).epsilon(1e-6));
+    const Box3d b = boundingBox(turned);
+    CHECK(b.min[2] == 0.0);
+    double bedArea = 0.0;
+    for (const Triangle& t : turned.triangles)
+        if (turned.positions[t[0]][2] == 0.0f && turned.positions[t[1]][2] == 0.0f && turned.positions[t[2]][2] == 0.0f)
+            bedArea += meshAreaMm2(TriMesh{{turned.positions[t[0]], turned.positions[t[1]], turned.positions[t[2]]},
+                                           {{0, 1, 2}},
+                                           {}});
+    CHECK(bedArea == doctest::Approx(std::acos(-1.0) * 900.0).epsilon(0.01));  // the cap, r = 30 mm
+    // The upper half already has its cap down: only moved to z = 0.
+    const TriMesh upper = clipByPlane(makeSphere({0, 0, 0}, 30, 31, 64), 2, 0.0, false);
+    CHECK(orientOnBed(upper, {200, 200, 200}).triangles == upper.triangles);
+    CHECK(boundingBox(orientOnBed(upper, {200, 200, 200})).size()[2] == doctest::Approx(boundingBox(upper).size()[2]));
+    // A box lies on its largest face, unless only standing fits the printer.
+    CHECK(boundingBox(orientOnBed(makeBox({0, 0, 0}, {150, 50, 190}), {200, 200, 200})).size()[2] == 50.0);
+    CHECK(boundingBox(orientOnBed(makeBox({0, 0, 0}, {150, 50, 190}), {200, 200, 60})).size()[2] == 50.0);
+    CHECK(boundingBox(orientOnBed(makeBox({0, 0, 0}, {150, 50, 190}), {160, 160, 200})).size()[2] == 190.0);
+    CHECK(boundingBox(orientOnBed(makeBox({0, 0, 0}, {150, 190, 50}), {160, 160, 200})).size()[2] == 190.0);
+}
+
 TEST_CASE("print_estimate: the octree baseline cuts until every part fits, and keeps the volume") {
     SUBCASE("a long box becomes eight octants") {
         const TriMesh box = makeBox({0, 0, 0}, {300, 100, 100});

@@ -48,7 +48,7 @@ struct PartitionOptions {
     /// The schedule bottoms out when the next w_smoothness would fall below this; oversized
     /// partitions are then split (and the result says so).
     double smoothnessMin = 1e-3;
-    Vec3d printerMm{200.0, 200.0, 200.0};  ///< build volume (paper: Ultimaker 3, 215×215×200 → 200³)
+    Vec3d printerMm{200.0, 200.0, 200.0};  ///< build volume, mm (about the paper's Ultimaker 3)
     /// Every side of a piece's oriented box is grown by this much before the fit test, for the
     /// shell's thickness behind the surface and the connectors (mm).
     double fitMarginMm = 2.0;
@@ -60,8 +60,9 @@ struct PartitionOptions {
 
     // --- planar cuts (§5.2) -------------------------------------------------------------------
     CellTrainingOptions svm;  ///< seed is taken from @c seed below
-    /// Training samples at most: above it, all faces near a seam are kept and the others thinned
-    /// evenly (deterministic), which keeps training time flat on large meshes.
+    /// Training samples at most: above it, up to half go to faces within two rings of a class
+    /// boundary and the rest to the other faces, each thinned evenly in face order (deterministic),
+    /// which keeps training time flat on large meshes.
     size_t svmMaxSamples = 20000;
     /// Retraining rounds when a cut crosses a salient region (its samples weighted up each round).
     int salientRetries = 3;

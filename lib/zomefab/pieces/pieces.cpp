@@ -755,6 +755,9 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
 
     const float bg = field.background;
     std::vector<FloatGrid::Ptr> grids(pieceCount);
+    // Where meshing keeps full resolution: around tenons (the pegs must keep their section) and
+    // engraved numbers (strokes of two voxels would blur into the surface).
+    std::vector<openvdb::BoolTree::Ptr> fullResolution(pieceCount);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, pieceCount, 1), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t p = range.begin(); p < range.end(); ++p) {
             context.throwIfCancelled();
@@ -793,9 +796,11 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
                 }
                 return openvdb::CoordBBox(lo, hi);
             };
+            auto mask = std::make_shared<openvdb::BoolTree>(false);
             // Tenons: union, ψ = min(ψ, τ).
             for (const Tenon& t : piece.tenons) {
                 const openvdb::CoordBBox box = indexBox(tenonBoundsMm(t, opt.tenons));
+                mask->fill(box, true, true);
                 for (auto it = box.begin(); it; ++it) {
                     const Coord ijk = *it;
                     const double tau = tenonSignedDistanceMm(t, opt.tenons, field.world(ijk));
@@ -810,6 +815,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
             if (piece.label) {
                 const std::vector<Stroke> strokes = labelStrokes(piece.label->text, opt.label);
                 const openvdb::CoordBBox box = indexBox(labelBoundsMm(*piece.label, opt.label));
+                mask->fill(box, true, true);
                 for (auto it = box.begin(); it; ++it) {
                     const Coord ijk = *it;
                     const double e = -labelSignedDistanceMm(*piece.label, strokes, opt.label, field.world(ijk));
@@ -822,6 +828,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
             }
             openvdb::tools::pruneLevelSet(grid->tree());
             grids[p] = std::move(grid);
+            if (!mask->empty()) fullResolution[p] = std::move(mask);
         }
     });
     context.throwIfCancelled();
@@ -837,8 +844,10 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
         for (size_t p = range.begin(); p < range.end(); ++p) {
             context.throwIfCancelled();
             openvdb::tools::VolumeToMesh mesher(0.0, opt.adaptivity, /*relaxDisorientedTriangles=*/true);
+            if (fullResolution[p]) mesher.setAdaptivityMask(fullResolution[p]);
             tbb::this_task_arena::isolate([&] { meshes[p] = meshGrid(mesher, *grids[p], voxelVolume); });
             grids[p].reset();
+            fullResolution[p].reset();
             context.progress("pieces", 0.5 + 0.4 * double(++meshed) / double(pieceCount));
         }
     });

@@ -78,10 +78,20 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piece
         PrintEstimate sum;
         for (size_t i = 0; i < meshes.size(); ++i) {
             context.throwIfCancelled();
-            if (options.source == EstimateSource::PrusaSlicer)
-                sum += sliceWithPrusaSlicer(meshes[i], settings, what + " " + std::to_string(i), options.slicer, context);
-            else
+            const std::string label = what + " " + std::to_string(i) + " at " + fixed(settings.infillPercent, 0) + "%";
+            if (options.source == EstimateSource::PrusaSlicer) {
+                try {
+                    sum += sliceWithPrusaSlicer(meshes[i], settings, label, options.slicer, context);
+                } catch (const Error& e) {
+                    if (e.code() != ErrorCode::ProcessingFailed) throw;
+                    // One odd part should not void the whole report: say so and estimate it.
+                    context.warn(std::string(e.what()) + "; the estimator's numbers are used for it");
+                    report.slicerFallbacks.push_back(label);
+                    sum += estimatePrint(meshes[i], settings, options.rates);
+                }
+            } else {
                 sum += estimatePrint(meshes[i], settings, options.rates);
+            }
             context.progress("report", double(++done) / double(total));
         }
         return sum;
@@ -122,6 +132,7 @@ nlohmann::json costReportToJson(const CostReport& r) {
                          {"saved_material_percent", c.savedMaterialPercent},
                          {"saved_filament_percent", c.savedFilamentPercent}});
     return {{"source", estimateSourceName(r.source)},
+            {"slicer_fallbacks", r.slicerFallbacks},
             {"pieces", r.pieceCount},
             {"baseline_parts", r.baselinePartCount},
             {"object_volume_mm3", r.objectVolumeMm3},

@@ -76,13 +76,17 @@ struct CostReport {
     double piecesVolumeMm3 = 0.0;
     zome::PartsList parts;
     EstimateSource source = EstimateSource::Estimator;
+    /// Parts the slicer failed on (e.g. "baseline part 3 at 20%"), estimated instead, each with a
+    /// warning on the run context.
+    std::vector<std::string> slicerFallbacks;
     CostOptions options;              ///< the options used, echoed into the JSON
 };
 
 /// Builds the report. @p objectMm is the closed input object in mm as it would be printed whole
 /// (z up); @p piecesMm the closed pieces as they will be printed (print orientation); @p parts the
 /// frame's parts list. With EstimateSource::PrusaSlicer every piece and baseline part is sliced
-/// (2 × (pieces + parts) slicer runs; progress through @p context).
+/// (2 × (pieces + parts) slicer runs; progress through @p context); a part the slicer fails on is
+/// estimated instead, with a warning, and listed in CostReport::slicerFallbacks.
 /// @throw Error(Usage) for invalid options, as octreeParts() and sliceWithPrusaSlicer().
 CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piecesMm, const zome::PartsList& parts,
                       const CostOptions& options = {}, RunContext& context = RunContext::silent());

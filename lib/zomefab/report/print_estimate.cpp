@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "zomefab/core/error.h"
@@ -125,6 +126,65 @@ bool fitsPrinter(const Vec3d& sizeMm, const Vec3d& printerMm) {
     return true;
 }
 
+TriMesh orientOnBed(const TriMesh& part, const Vec3d& printerMm) {
+    if (part.triangles.empty()) return part;
+    const Box3d box = boundingBox(part);
+    // Candidate "down" directions: axis k, sign −1 (the face at the minimum) or +1 (the maximum).
+    // Flat facets count when their normal points that way and all corners lie within 0.01 mm of
+    // the extreme.
+    std::array<double, 6> area{};
+    for (const Triangle& t : part.triangles) {
+        const Vec3f &a = part.positions[t[0]], &b = part.positions[t[1]], &c = part.positions[t[2]];
+        const double ux = double(b[0]) - a[0], uy = double(b[1]) - a[1], uz = double(b[2]) - a[2];
+        const double vx = double(c[0]) - a[0], vy = double(c[1]) - a[1], vz = double(c[2]) - a[2];
+        const std::array<double, 3> n = {uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx};
+        const double twice = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (twice == 0.0) continue;
+        for (int k = 0; k < 3; ++k)
+            for (int side = 0; side < 2; ++side) {
+                const double sign = side == 0 ? -1.0 : 1.0;
+                if (sign * n[size_t(k)] < twice * (1.0 - 1e-6)) continue;
+                const double extreme = side == 0 ? box.min[size_t(k)] : box.max[size_t(k)];
+                if (std::abs(a[size_t(k)] - extreme) <= 0.01 && std::abs(b[size_t(k)] - extreme) <= 0.01 &&
+                    std::abs(c[size_t(k)] - extreme) <= 0.01)
+                    area[size_t(2 * k + side)] += 0.5 * twice;
+            }
+    }
+    // Order of preference on ties: −z (as given), +z, −x, +x, −y, +y.
+    const int order[6] = {4, 5, 0, 1, 2, 3};
+    const Vec3d size = box.size();
+    int best = -1;
+    double bestArea = 0.0;
+    for (int candidate : order) {
+        const int k = candidate / 2;
+        const double height = size[size_t(k)], u = size[size_t((k + 1) % 3)], v = size[size_t((k + 2) % 3)];
+        const bool fits = height <= printerMm[2] + 1e-6 &&
+                          ((u <= printerMm[0] + 1e-6 && v <= printerMm[1] + 1e-6) ||
+                           (v <= printerMm[0] + 1e-6 && u <= printerMm[1] + 1e-6));
+        if (fits && area[size_t(candidate)] > bestArea * (1.0 + 1e-9)) best = candidate, bestArea = area[size_t(candidate)];
+    }
+    TriMesh out = part;
+    if (best < 0) best = 4;
+    // Rows of the rotation taking the chosen direction to −z (each a signed axis permutation, det +1).
+    static const int rows[6][3][3] = {
+        {{0, 0, -1}, {0, 1, 0}, {1, 0, 0}},   // −x down: x → z
+        {{0, 0, 1}, {0, 1, 0}, {-1, 0, 0}},   // +x down: x → −z
+        {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}},   // −y down: y → z
+        {{1, 0, 0}, {0, 0, 1}, {0, -1, 0}},   // +y down: y → −z
+        {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}},    // −z down: as given
+        {{1, 0, 0}, {0, -1, 0}, {0, 0, -1}},  // +z down: 180° about x
+    };
+    float zMin = std::numeric_limits<float>::max();
+    for (Vec3f& p : out.positions) {
+        const Vec3f q = p;
+        for (int r = 0; r < 3; ++r)
+            p[size_t(r)] = float(rows[best][r][0]) * q[0] + float(rows[best][r][1]) * q[1] + float(rows[best][r][2]) * q[2];
+        zMin = std::min(zMin, p[2]);
+    }
+    for (Vec3f& p : out.positions) p[2] -= zMin;
+    return out;
+}
+
 namespace {
 
 void splitUntilFits(const TriMesh& part, const Box3d& cell, const Vec3d& printerMm, int depthLeft,
@@ -132,7 +192,7 @@ void splitUntilFits(const TriMesh& part, const Box3d& cell, const Vec3d& printer
     context.throwIfCancelled();
     if (part.triangles.empty()) return;
     if (fitsPrinter(boundingBox(part).size(), printerMm)) {
-        out.push_back(part);
+        out.push_back(orientOnBed(part, printerMm));
         return;
     }
     if (depthLeft == 0)

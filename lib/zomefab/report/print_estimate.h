@@ -90,10 +90,18 @@ PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& settings, 
 /// The parts of the paper's baseline (§7.2): the object's bounding box is split as an octree and
 /// each cell's part (the object clipped to the cell, capped) is split again until it fits the
 /// printer in one of the six axis-aligned orientations. Empty cells are dropped; parts come in
-/// octant order. @throw Error(Usage) when @p printerMm has a non-positive size or a part still
-/// does not fit after @p maxDepth levels; as clipByPlane() for an open mesh.
+/// octant order, each turned onto the bed by orientOnBed(). @throw Error(Usage) when @p printerMm
+/// has a non-positive size or a part still does not fit after @p maxDepth levels; as
+/// clipByPlane() for an open mesh.
 std::vector<TriMesh> octreeParts(const TriMesh& object, const Vec3d& printerMm, int maxDepth = 10,
                                  RunContext& context = RunContext::silent());
+
+/// @p part turned in 90° steps so that its largest flat face lies on the bed, as a user prints a
+/// cut part (a cap down, not a tip: PrusaSlicer refuses a part with nothing in its first layer),
+/// then moved to z = 0. Of the six axis directions, the one whose flat facets at the extreme cover
+/// the most area becomes −z, among those orientations that fit @p printerMm (x and y may swap);
+/// ties and parts without flat faces keep their orientation. Rotations are exact (axis swaps).
+TriMesh orientOnBed(const TriMesh& part, const Vec3d& printerMm);
 
 /// True when a box of size @p sizeMm fits in @p printerMm after some axis permutation.
 bool fitsPrinter(const Vec3d& sizeMm, const Vec3d& printerMm);
