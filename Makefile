@@ -7,7 +7,7 @@ DEMO_DIR  ?= out/demo
 
 # Libraries the build needs.
 BUILD_PACKAGES := cmake g++ make libopenvdb-dev libtbb-dev libeigen3-dev libdraco-dev libtinygltf-dev \
-                  libstb-dev libboost-iostreams-dev doctest-dev libmaxflow-dev liblinear-dev libcli11-dev nlohmann-json3-dev
+                  libstb-dev libboost-iostreams-dev doctest-dev libmaxflow-dev liblinear-dev libcli11-dev nlohmann-json3-dev zlib1g-dev
 # Real checkers the tests run on the outputs: admesh (STL manifold check), draco_decoder, prusa-slicer.
 TEST_PACKAGES  := admesh draco prusa-slicer
 # The Khronos glTF-Validator (npm), installed once into $(BUILD_DIR)/node; the GLB tests run it with node.

@@ -29,12 +29,15 @@ struct LoadedPieces {
 
 Transform4d matrixFrom(const nlohmann::json& rows, const std::string& file, const std::string& what) {
     Transform4d t;
-    if (!rows.is_array() || rows.size() != 4) throw Error(ErrorCode::InvalidInput, what + " is not a 4x4 matrix", file);
+    if (!rows.is_array() || rows.size() != 4)
+        throw Error(ErrorCode::InvalidInput, what + " is not a 4x4 matrix", file);
     for (int r = 0; r < 4; ++r) {
         const nlohmann::json& row = rows[size_t(r)];
-        if (!row.is_array() || row.size() != 4) throw Error(ErrorCode::InvalidInput, what + " is not a 4x4 matrix", file);
+        if (!row.is_array() || row.size() != 4)
+            throw Error(ErrorCode::InvalidInput, what + " is not a 4x4 matrix", file);
         for (int c = 0; c < 4; ++c) {
-            if (!row[size_t(c)].is_number()) throw Error(ErrorCode::InvalidInput, what + " has a non-number", file);
+            if (!row[size_t(c)].is_number())
+                throw Error(ErrorCode::InvalidInput, what + " has a non-number", file);
             t.m[size_t(r * 4 + c)] = row[size_t(c)].get<double>();
         }
     }
@@ -53,12 +56,14 @@ LoadedPieces readPiecesJson(const std::string& path) {
     if (!j.is_object() || j.value("format", "") != "zomefab.pieces")
         throw Error(ErrorCode::InvalidInput, "not a pieces file (format zomefab.pieces)", path);
     if (j.value("version", 0) != 1)
-        throw Error(ErrorCode::InvalidInput, "unsupported version " + j.value("version", nlohmann::json()).dump(), path);
+        throw Error(ErrorCode::InvalidInput,
+                    "unsupported version " + j.value("version", nlohmann::json()).dump(), path);
     if (!j.contains("pieces") || !j["pieces"].is_array())
         throw Error(ErrorCode::InvalidInput, "no pieces array", path);
     const Transform4d gridToFrame =
-        j.contains("frame_to_grid_mm") ? affineInverse(matrixFrom(j["frame_to_grid_mm"], path, "frame_to_grid_mm"))
-                                       : Transform4d::identity();
+        j.contains("frame_to_grid_mm")
+            ? affineInverse(matrixFrom(j["frame_to_grid_mm"], path, "frame_to_grid_mm"))
+            : Transform4d::identity();
     const fs::path dir = fs::path(path).parent_path();
     LoadedPieces out;
     for (size_t i = 0; i < j["pieces"].size(); ++i) {
@@ -69,8 +74,9 @@ LoadedPieces readPiecesJson(const std::string& path) {
         const fs::path file = dir / p["file"].get<std::string>();
         out.meshes.push_back(readMesh(file.string()));
         if (p.contains("orientation") && p["orientation"].contains("transform_mm"))
-            out.toFrame.push_back(gridToFrame * affineInverse(matrixFrom(p["orientation"]["transform_mm"], path,
-                                                                         what + ".orientation.transform_mm")));
+            out.toFrame.push_back(gridToFrame *
+                                  affineInverse(matrixFrom(p["orientation"]["transform_mm"], path,
+                                                           what + ".orientation.transform_mm")));
         else
             out.toFrame.push_back(gridToFrame);
         out.names.push_back(file.stem().string());
@@ -82,15 +88,18 @@ LoadedPieces readPiecesJson(const std::string& path) {
 LoadedPieces readPieces(const std::string& path) {
     std::error_code ec;
     if (!fs::is_directory(path, ec)) return readPiecesJson(path);
-    if (fs::exists(fs::path(path) / "pieces.json")) return readPiecesJson((fs::path(path) / "pieces.json").string());
+    if (fs::exists(fs::path(path) / "pieces.json"))
+        return readPiecesJson((fs::path(path) / "pieces.json").string());
     std::vector<fs::path> files;
     for (const fs::directory_entry& e : fs::directory_iterator(path, ec)) {
         const std::string ext = fileExtension(e.path().string());
-        if (e.is_regular_file() && (ext == "stl" || ext == "obj" || ext == "ply" || ext == "glb" || ext == "gltf"))
+        if (e.is_regular_file() &&
+            (ext == "stl" || ext == "obj" || ext == "ply" || ext == "glb" || ext == "gltf"))
             files.push_back(e.path());
     }
     if (ec) throw Error(ErrorCode::InvalidInput, "cannot list the directory: " + ec.message(), path);
-    if (files.empty()) throw Error(ErrorCode::InvalidInput, "no pieces.json and no mesh files in the directory", path);
+    if (files.empty())
+        throw Error(ErrorCode::InvalidInput, "no pieces.json and no mesh files in the directory", path);
     std::sort(files.begin(), files.end());
     LoadedPieces out;
     for (const fs::path& f : files) {
@@ -137,7 +146,8 @@ int main(int argc, char** argv) {
         input.frame = &frame;
         input.extras = {{"frame_file", framePath}};
         const std::string glb = serializeGlb(report::buildPreviewScene(input, options), options.glb);
-        writeOutputAtomic(output, [&](std::ostream& out) { out.write(glb.data(), std::streamsize(glb.size())); });
+        writeOutputAtomic(output,
+                          [&](std::ostream& out) { out.write(glb.data(), std::streamsize(glb.size())); });
 
         report["frame"] = framePath;
         report["pieces"] = input.pieces.size();
@@ -149,8 +159,9 @@ int main(int argc, char** argv) {
         char size[64];
         std::snprintf(size, sizeof size, "%.1f kB", double(glb.size()) / 1000.0);
         cli::printInfo(tool, framePath + ": " + std::to_string(frame.ballCount()) + " balls, " +
-                                 std::to_string(frame.strutCount()) + " struts, " + std::to_string(input.pieces.size()) +
-                                 " pieces -> " + output + " (" + size + ")");
+                                 std::to_string(frame.strutCount()) + " struts, " +
+                                 std::to_string(input.pieces.size()) + " pieces -> " + output + " (" + size +
+                                 ")");
         return 0;
     });
 }

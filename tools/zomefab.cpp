@@ -112,7 +112,7 @@ struct RunCommand {
         char line[256];
         std::snprintf(line, sizeof line, "%.0f x %.0f x %.0f mm: %zu balls, %zu struts, %zu pieces; %.1f s",
                       result.scaled.sizeMm[0], result.scaled.sizeMm[1], result.scaled.sizeMm[2], parts.balls,
-                      parts.strutTotal(), result.partition.pieces.size(), result.totalSeconds);
+                      parts.strutTotal(), result.pieces.pieces.size(), result.totalSeconds);
         cli::printInfo(tool, line);
         std::string list;
         for (const std::string& f : files) list += (list.empty() ? "" : ", ") + f;

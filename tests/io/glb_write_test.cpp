@@ -2,8 +2,9 @@
 /// @file The GLB writer: container layout, accessors and bounds, instancing, Draco primitives
 /// decoded back (in process and with the draco_decoder tool), the Khronos glTF-Validator (run
 /// through node when it is installed), and reading glTF and writing a Draco GLB in one process.
-#include <doctest/doctest.h>
+#include "zomefab/io/glb_write.h"
 
+#include <doctest/doctest.h>
 #include <draco/compression/decode.h>
 #include <draco/mesh/mesh.h>
 
@@ -18,7 +19,6 @@
 #include "io_test_util.h"
 #include "test_util.h"
 #include "zomefab/io/file_io.h"
-#include "zomefab/io/glb_write.h"
 #include "zomefab/io/mesh_io.h"
 
 using namespace zomefab;
@@ -126,8 +126,8 @@ bool hasCommand(const std::string& name) {
 
 /// Runs the Khronos validator on @p path; returns its JSON summary (errors, warnings, messages).
 nlohmann::json khronosValidate(const std::string& path) {
-    const std::string cmd = "node '" + std::string(ZOMEFAB_VALIDATOR_SCRIPT) + "' '" + nodePrefix() + "' '" + path +
-                            "' 2>&1";
+    const std::string cmd =
+        "node '" + std::string(ZOMEFAB_VALIDATOR_SCRIPT) + "' '" + nodePrefix() + "' '" + path + "' 2>&1";
     FILE* pipe = ::popen(cmd.c_str(), "r");
     REQUIRE(pipe != nullptr);
     std::string out;
@@ -201,7 +201,8 @@ TEST_CASE("glb_write: Draco primitives decode to the mesh, within the quantisati
     CHECK(mesh->num_faces() == original.triangles.size());
     CHECK(pos["count"] == mesh->num_points());
     CHECK(j["accessors"][prim["indices"].get<size_t>()]["count"] == 3 * original.triangles.size());
-    const draco::PointAttribute* att = mesh->GetAttributeByUniqueId(ext["attributes"]["POSITION"].get<uint32_t>());
+    const draco::PointAttribute* att =
+        mesh->GetAttributeByUniqueId(ext["attributes"]["POSITION"].get<uint32_t>());
     REQUIRE(att != nullptr);
     // 14 bits over a 50 mm box: every decoded point lies within 0.004 mm of an input vertex.
     const double step = 50.0 / ((1 << 14) - 1);
@@ -227,7 +228,8 @@ TEST_CASE("glb_write: Draco primitives decode to the mesh, within the quantisati
         att->GetMappedValue(mesh->face(f)[1], b);
         att->GetMappedValue(mesh->face(f)[2], c);
         volume += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-                   a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
+                   a[2] * (b[0] * c[1] - b[1] * c[0])) /
+                  6.0;
     }
     CHECK(volume == doctest::Approx(signedVolume(original)).epsilon(1e-3));
 }
@@ -311,9 +313,10 @@ TEST_CASE("glb_write: draco_decoder decodes every compressed primitive") {
     const Glb g = parseGlb(serializeGlb(testScene()));
     const nlohmann::json& prim = g.json["meshes"][0]["primitives"][0];
     ScratchDir dir("zomefab-drc");
-    writeBytes(dir.file("sphere.drc"), viewBytes(g, prim["extensions"]["KHR_draco_mesh_compression"]["bufferView"]));
-    const std::string cmd = "draco_decoder -i '" + dir.file("sphere.drc") + "' -o '" + dir.file("sphere.obj") +
-                            "' > /dev/null 2>&1";
+    writeBytes(dir.file("sphere.drc"),
+               viewBytes(g, prim["extensions"]["KHR_draco_mesh_compression"]["bufferView"]));
+    const std::string cmd = "draco_decoder -i '" + dir.file("sphere.drc") + "' -o '" +
+                            dir.file("sphere.obj") + "' > /dev/null 2>&1";
     REQUIRE(std::system(cmd.c_str()) == 0);
     std::ifstream obj(dir.file("sphere.obj"));
     std::string line;
@@ -322,7 +325,8 @@ TEST_CASE("glb_write: draco_decoder decodes every compressed primitive") {
         if (line.rfind("v ", 0) == 0) ++vertices;
         if (line.rfind("f ", 0) == 0) ++faces;
     }
-    CHECK(vertices == g.json["accessors"][prim["attributes"]["POSITION"].get<size_t>()]["count"].get<size_t>());
+    CHECK(vertices ==
+          g.json["accessors"][prim["attributes"]["POSITION"].get<size_t>()]["count"].get<size_t>());
     CHECK(3 * faces == g.json["accessors"][prim["indices"].get<size_t>()]["count"].get<size_t>());
 }
 

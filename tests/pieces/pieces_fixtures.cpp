@@ -2,21 +2,59 @@
 #include "pieces_fixtures.h"
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 
-#include "test_util.h"
+#include <fstream>
+#include "zomefab/core/error.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/pieces/detail/vec.h"
 #include "zomefab/zome/golden.h"
+#include "zomefab/sdf/vdb_file.h"
+#include "zomefab/zome/structure_json.h"
 
 namespace zomefab::pieces::test {
 
 using namespace detail;
 
+namespace {
+
+/// A closed, outward UV sphere (poles fanned).
+TriMesh uvSphere(const Vec3d& c, double r, int rings, int segments) {
+    TriMesh m;
+    const double pi = std::acos(-1.0);
+    m.positions.push_back({float(c[0]), float(c[1]), float(c[2] + r)});
+    for (int i = 1; i < rings; ++i)
+        for (int j = 0; j < segments; ++j) {
+            const double theta = pi * i / rings, phi = 2 * pi * j / segments;
+            m.positions.push_back({float(c[0] + r * std::sin(theta) * std::cos(phi)),
+                                   float(c[1] + r * std::sin(theta) * std::sin(phi)), float(c[2] + r * std::cos(theta))});
+        }
+    m.positions.push_back({float(c[0]), float(c[1]), float(c[2] - r)});
+    const uint32_t south = uint32_t(m.positions.size() - 1);
+    auto ring = [&](int i, int j) { return uint32_t(1 + (i - 1) * segments + (j % segments)); };
+    for (int j = 0; j < segments; ++j) m.triangles.push_back({0, ring(1, j), ring(1, j + 1)});
+    for (int i = 1; i < rings - 1; ++i)
+        for (int j = 0; j < segments; ++j) {
+            m.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
+            m.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
+        }
+    for (int j = 0; j < segments; ++j) m.triangles.push_back({south, ring(rings - 1, j + 1), ring(rings - 1, j)});
+    return m;
+}
+
+void writeFile(const std::string& path, const std::string& bytes) {
+    std::ofstream out(path, std::ios::binary);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+    if (!out) throw Error(ErrorCode::WriteFailed, "cannot write", path);
+}
+
+}  // namespace
+
 sdf::LevelSet makeSphereShell(const Vec3d& c, double r, double t, double voxel) {
     sdf::MeshToLevelSetOptions o;
     o.voxelMm = voxel;
     o.interiorBandMm = t;
-    const TriMesh sphere = zomefab::test::makeSphere(c, r, 96, 192);
+    const TriMesh sphere = uvSphere(c, r, 96, 192);
     const sdf::LevelSet object = sdf::meshToLevelSet(sphere, o, RunContext::silent());
     return sdf::makeShell(object, {t}, RunContext::silent());
 }
@@ -106,6 +144,31 @@ TriMesh gridMesh(const Piece& piece) {
     TriMesh m = piece.mesh;
     transformInPlace(m, affineInverse(piece.gridToPrintMm));
     return m;
+}
+
+void writeToolInputs(const std::string& dir) {
+    const sdf::LevelSet shell = makeSphereShell({0, 0, 0}, 75.0, 8.0, 1.0);
+    writeFile(dir + "/shell.vdb", sdf::serializeVdb({shell}));
+    const zome::Structure frame = makeCubeLattice(75.0 - 8.0 - 8.85 - 3.0);
+    writeFile(dir + "/frame.json", zome::structureToJson(frame).dump(1));
+    const CellModel cells = quadrantCells(-5.3, 10.4);
+    auto partition = [&](const Transform4d& t) {
+        nlohmann::json j;
+        j["format"] = "zomefab.partition";
+        j["version"] = 1;
+        nlohmann::json rows = nlohmann::json::array();
+        for (int r = 0; r < 4; ++r) rows.push_back({t.at(r, 0), t.at(r, 1), t.at(r, 2), t.at(r, 3)});
+        j["transform_mm"] = rows;
+        j["printer_mm"] = {200, 200, 200};
+        for (size_t k = 0; k < cells.cellCount(); ++k) {
+            j["cells"].push_back({{"cell", k}, {"w", cells.w[k]}, {"b", cells.b[k]}});
+            j["pieces"].push_back({{"piece", k}, {"cells", {k}}});
+        }
+        return j.dump(1);
+    };
+    writeFile(dir + "/partition.json", partition(Transform4d::identity()));
+    writeFile(dir + "/bad-transform.json", partition(Transform4d::scaleTranslate(1.0, {5, 0, 0})));
+    writeFile(dir + "/not-partition.json", "{\"format\": \"zomefab.structure\", \"version\": 1}");
 }
 
 }  // namespace zomefab::pieces::test

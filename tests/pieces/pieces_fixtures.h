@@ -38,4 +38,10 @@ std::optional<double> firstHit(const TriMesh& mesh, const Vec3d& origin, const V
 /// @p piece's mesh in the shell grid's mm (undoes the print orientation).
 TriMesh gridMesh(const Piece& piece);
 
+/// Writes zf-pieces inputs into @p directory: shell.vdb (a 150 mm sphere, 8 mm wall, 1 mm voxel),
+/// frame.json (the B0 lattice inside: 7 balls), partition.json (the quadrants x ≶ −5.3, z ≶ 10.4
+/// as cells and pieces, printer 200 mm), and for the error tests bad-transform.json (the same
+/// partition made with another frame transform) and not-partition.json.
+void writeToolInputs(const std::string& directory);
+
 }  // namespace zomefab::pieces::test

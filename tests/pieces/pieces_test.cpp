@@ -315,11 +315,21 @@ TEST_CASE("pieces: the engraved number is cut into the inner surface") {
         auto at = [&](double x, double y, double z) {
             return madd(madd(madd(l.centerGridMm, x, right), y, l.upGrid), z, l.normalGrid);
         };
-        // Half the depth under the underline: engraved (outside the piece); beside the label: wall.
+        // The inner sphere below a point of the label's plane, along the normal (into the wall).
+        auto below = [&](double x, double y, double depth) {
+            const Vec3d q = at(x, y, 0);
+            const Vec3d n = l.normalGrid;  // points to the centre
+            // |q − s·n| = R − T for the s > 0 that reaches the sphere.
+            const double b = dot(q, n), c = dot(q, q) - std::pow(kRadius - kShell, 2);
+            const double s = b + std::sqrt(b * b - c);
+            return madd(q, -(s + depth), n);
+        };
+        // Half the depth under the underline's surface: engraved (outside the piece); beside the
+        // label at the same depth and below the engraving: wall.
         const Stroke& underline = strokes.back();
-        CHECK(!isInsideMesh(m, at(underline.centerX, underline.centerY, -0.5 * o.label.depthMm)));
-        CHECK(isInsideMesh(m, at(0.5 * l.widthMm + 2.0, 0, -0.5 * o.label.depthMm)));
-        CHECK(isInsideMesh(m, at(underline.centerX, underline.centerY, -o.label.depthMm - 0.8)));
+        CHECK(!isInsideMesh(m, below(underline.centerX, underline.centerY, 0.5 * o.label.depthMm)));
+        CHECK(isInsideMesh(m, below(0.5 * l.widthMm + 1.5, 0, 0.5 * o.label.depthMm)));
+        CHECK(isInsideMesh(m, below(underline.centerX, underline.centerY, o.label.depthMm + 1.0)));
     }
     CHECK(labelled >= 1);
 }

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file Build order of the assembly guide, tenon checks and the Markdown/JSON forms.
+#include "zomefab/report/assembly_guide.h"
+
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -8,7 +10,6 @@
 #include "report_test_util.h"
 #include "zomefab/core/error.h"
 #include "zomefab/io/file_io.h"
-#include "zomefab/report/assembly_guide.h"
 #include "zomefab/zome/structure_json.h"
 
 using namespace zomefab;
@@ -36,7 +37,8 @@ void checkGuide(const zome::Structure& frame, const AssemblyGuide& g) {
         for (const StrutStep& s : step.struts) {
             CHECK(struts.insert(s.strut).second);  // every strut once
             const zome::Strut& real = frame.strut(s.strut);
-            CHECK(((real.a == step.ball && real.b == s.toBall) || (real.b == step.ball && real.a == s.toBall)));
+            CHECK(
+                ((real.a == step.ball && real.b == s.toBall) || (real.b == step.ball && real.a == s.toBall)));
             CHECK(frame.ball(step.ball).holes[size_t(s.hole)] == s.strut);
             CHECK(frame.ball(s.toBall).holes[size_t(s.toHole)] == s.strut);
             CHECK(s.isNewBall == (present.count(s.toBall) == 0));
@@ -55,7 +57,7 @@ TEST_CASE("assembly_guide: a cube frame, breadth-first from its lowest ball") {
     const AssemblyGuide g = assemblyGuide(cube);
     checkGuide(cube, g);
     CHECK(g.components == 1);
-    CHECK(g.layers == 4);  // corner, 3 neighbours, 3 face-diagonal corners, the far corner
+    CHECK(g.layers == 4);         // corner, 3 neighbours, 3 face-diagonal corners, the far corner
     CHECK(g.steps[0].ball == 0);  // at z = 0, y = 0, x = 0
     CHECK(g.steps[0].struts.size() == 3);
     const std::vector<size_t> perLayer = {1, 3, 3, 1};

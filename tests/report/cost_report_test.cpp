@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file The Table 1 report: assembly time model, savings arithmetic, JSON and Markdown.
+#include "zomefab/report/cost_report.h"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
 
 #include "report_fixtures.h"
 #include "zomefab/core/error.h"
-#include "zomefab/report/cost_report.h"
 #include "zomefab/report/mesh_clip.h"
 
 using namespace zomefab;
@@ -72,8 +73,10 @@ TEST_CASE("cost_report: hollow and solid cases against the octree baseline") {
     CHECK(solid.name == "solid");
     for (const CostCase* c : {&hollow, &solid}) {
         // Savings are 1 − zomefab/baseline, on overall hours and overall USD (paper Table 1).
-        CHECK(c->savedTimePercent == doctest::Approx(100 * (1 - c->zomefab.totalHours() / c->baseline.totalHours())));
-        CHECK(c->savedMaterialPercent == doctest::Approx(100 * (1 - c->zomefab.totalUsd() / c->baseline.totalUsd())));
+        CHECK(c->savedTimePercent ==
+              doctest::Approx(100 * (1 - c->zomefab.totalHours() / c->baseline.totalHours())));
+        CHECK(c->savedMaterialPercent ==
+              doctest::Approx(100 * (1 - c->zomefab.totalUsd() / c->baseline.totalUsd())));
         CHECK(c->zomefab.zomeUsd == doctest::Approx(481 * 0.19 + 126 * 0.29));
         CHECK(c->zomefab.assemblyHours == doctest::Approx(assemblyHours(parts)));
         CHECK(c->baseline.zomeUsd == 0.0);
@@ -108,16 +111,26 @@ TEST_CASE("cost_report: a part the slicer fails on is estimated instead, with a 
     o.source = EstimateSource::PrusaSlicer;
     o.slicer.executable = "false";
     std::vector<std::string> warnings;
-    RunContext context([&](LogLevel level, const std::string& m) { if (level == LogLevel::Warning) warnings.push_back(m); },
-                       nullptr);
+    RunContext context(
+        [&](LogLevel level, const std::string& m) {
+            if (level == LogLevel::Warning) warnings.push_back(m);
+        },
+        nullptr);
     const CostReport r = costReport(object, pieces, bunnyParts(), o, context);
-    CHECK(r.slicerFallbacks == std::vector<std::string>{"hollow piece 0 at 20%", "hollow baseline part 0 at 20%",
-                                                         "solid piece 0 at 100%", "solid baseline part 0 at 100%"});
+    CHECK(r.slicerFallbacks ==
+          std::vector<std::string>{"hollow piece 0 at 20%", "hollow baseline part 0 at 20%",
+                                   "solid piece 0 at 100%", "solid baseline part 0 at 100%"});
     REQUIRE(warnings.size() == 4);
     CHECK(warnings[0].find("false failed on hollow piece 0 at 20%") != std::string::npos);
     const CostReport model = costReport(object, pieces, bunnyParts());
     CHECK(r.cases[0].zomefab.print.seconds == model.cases[0].zomefab.print.seconds);
     CHECK(costReportToJson(r)["slicer_fallbacks"].size() == 4);
+    // A slicer that is not there at all is a usage error, before any work.
+    o.slicer.executable = "/nonexistent/prusa-slicer";
+    CHECK_THROWS_WITH_AS(
+        costReport(object, pieces, bunnyParts(), o),
+        "--slicer /nonexistent/prusa-slicer: not installed or not executable (Debian package prusa-slicer)",
+        Error);
 }
 
 TEST_CASE("cost_report: filament options change cost and length, not time") {

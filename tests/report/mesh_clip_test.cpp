@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file Planar cuts with caps: volumes, closedness, holes in the cut, vertices on the plane.
+#include "zomefab/report/mesh_clip.h"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -7,7 +9,6 @@
 #include "report_fixtures.h"
 #include "report_test_util.h"
 #include "zomefab/core/error.h"
-#include "zomefab/report/mesh_clip.h"
 
 using namespace zomefab;
 using namespace zomefab::report;
@@ -52,9 +53,9 @@ TEST_CASE("mesh_clip: the cap of a hollow sphere is an annulus (hole bridged int
 
 TEST_CASE("mesh_clip: two cavities in one cut and two separate outer loops") {
     // A 100 mm box with two cavities side by side, cut through both: one outer loop, two holes.
-    const TriMesh twoCavities = merged(makeBox({0, 0, 0}, {100, 40, 40}),
-                                      merged(reversed(makeBox({10, 10, 10}, {40, 30, 30})),
-                                             reversed(makeBox({60, 10, 10}, {90, 30, 30}))));
+    const TriMesh twoCavities = merged(
+        makeBox({0, 0, 0}, {100, 40, 40}),
+        merged(reversed(makeBox({10, 10, 10}, {40, 30, 30})), reversed(makeBox({60, 10, 10}, {90, 30, 30}))));
     const TriMesh cut = clipByPlane(twoCavities, 2, 20.0, true);
     CHECK(isClosedOriented(cut));
     CHECK(meshVolumeMm3(cut) == doctest::Approx(100.0 * 40 * 20 - 2 * 30.0 * 20 * 10).epsilon(1e-6));

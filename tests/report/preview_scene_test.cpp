@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file The preview scene: strut cross-sections and their orientation on the ball, instancing,
 /// node names, transforms that put every strut between its balls' surfaces, extras.
+#include "zomefab/report/preview_scene.h"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -10,7 +12,6 @@
 #include "report_test_util.h"
 #include "test_util.h"
 #include "zomefab/core/error.h"
-#include "zomefab/report/preview_scene.h"
 #include "zomefab/zome/parts.h"
 
 using namespace zomefab;
@@ -32,7 +33,8 @@ double polygonArea(const std::vector<std::array<double, 2>>& p) {
 Vec3d rotate(const std::array<double, 4>& q, const Vec3d& v) {
     const Vec3d u{q[0], q[1], q[2]};
     const double w = q[3];
-    const Vec3d t{2 * (u[1] * v[2] - u[2] * v[1]), 2 * (u[2] * v[0] - u[0] * v[2]), 2 * (u[0] * v[1] - u[1] * v[0])};
+    const Vec3d t{2 * (u[1] * v[2] - u[2] * v[1]), 2 * (u[2] * v[0] - u[0] * v[2]),
+                  2 * (u[0] * v[1] - u[1] * v[0])};
     return {v[0] + w * t[0] + (u[1] * t[2] - u[2] * t[1]), v[1] + w * t[1] + (u[2] * t[0] - u[0] * t[2]),
             v[2] + w * t[2] + (u[0] * t[1] - u[1] * t[0])};
 }
@@ -137,7 +139,8 @@ TEST_CASE("preview_scene: pieces, one instanced ball mesh, one mesh per strut ki
         const Vec3d tip = rotate(node->rotation, {0, 0, length});
         for (int k = 0; k < 3; ++k) {
             CHECK(node->translation[size_t(k)] == doctest::Approx(s.startMm[size_t(k)]));
-            CHECK(node->translation[size_t(k)] + tip[size_t(k)] == doctest::Approx(s.endMm[size_t(k)]).epsilon(1e-6));  // float mesh
+            CHECK(node->translation[size_t(k)] + tip[size_t(k)] ==
+                  doctest::Approx(s.endMm[size_t(k)]).epsilon(1e-6));  // float mesh
         }
         const Vec3d x = rotate(node->rotation, {1, 0, 0}), u = strutCrossSectionFrame(s.holeA);
         CHECK(x[0] * u[0] + x[1] * u[1] + x[2] * u[2] == doctest::Approx(1.0));

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file The print estimator's volume model, filament conversions and the octree baseline.
+#include "zomefab/report/print_estimate.h"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -8,7 +10,6 @@
 #include "report_test_util.h"
 #include "zomefab/core/error.h"
 #include "zomefab/report/mesh_clip.h"
-#include "zomefab/report/print_estimate.h"
 
 using namespace zomefab;
 using namespace zomefab::report;
@@ -111,15 +112,16 @@ TEST_CASE("print_estimate: parts are turned onto their largest flat face") {
     CHECK(b.min[2] == 0.0);
     double bedArea = 0.0;
     for (const Triangle& t : turned.triangles)
-        if (turned.positions[t[0]][2] == 0.0f && turned.positions[t[1]][2] == 0.0f && turned.positions[t[2]][2] == 0.0f)
-            bedArea += meshAreaMm2(TriMesh{{turned.positions[t[0]], turned.positions[t[1]], turned.positions[t[2]]},
-                                           {{0, 1, 2}},
-                                           {}});
+        if (turned.positions[t[0]][2] == 0.0f && turned.positions[t[1]][2] == 0.0f &&
+            turned.positions[t[2]][2] == 0.0f)
+            bedArea += meshAreaMm2(TriMesh{
+                {turned.positions[t[0]], turned.positions[t[1]], turned.positions[t[2]]}, {{0, 1, 2}}, {}});
     CHECK(bedArea == doctest::Approx(std::acos(-1.0) * 900.0).epsilon(0.01));  // the cap, r = 30 mm
     // The upper half already has its cap down: only moved to z = 0.
     const TriMesh upper = clipByPlane(makeSphere({0, 0, 0}, 30, 31, 64), 2, 0.0, false);
     CHECK(orientOnBed(upper, {200, 200, 200}).triangles == upper.triangles);
-    CHECK(boundingBox(orientOnBed(upper, {200, 200, 200})).size()[2] == doctest::Approx(boundingBox(upper).size()[2]));
+    CHECK(boundingBox(orientOnBed(upper, {200, 200, 200})).size()[2] ==
+          doctest::Approx(boundingBox(upper).size()[2]));
     // A box lies on its largest face, unless only standing fits the printer.
     CHECK(boundingBox(orientOnBed(makeBox({0, 0, 0}, {150, 50, 190}), {200, 200, 200})).size()[2] == 50.0);
     CHECK(boundingBox(orientOnBed(makeBox({0, 0, 0}, {150, 50, 190}), {200, 200, 60})).size()[2] == 50.0);

@@ -54,7 +54,8 @@ std::vector<double> solve(std::vector<std::vector<double>> a, std::vector<double
 
 /// Non-negative least squares of rows·x ≈ y on relative errors: refits without the most negative
 /// coefficient until all are ≥ 0.
-std::vector<double> fitNonNegative(const std::vector<std::vector<double>>& rows, const std::vector<double>& y) {
+std::vector<double> fitNonNegative(const std::vector<std::vector<double>>& rows,
+                                   const std::vector<double>& y) {
     const size_t n = rows[0].size();
     std::vector<char> isFree(n, 1);
     for (;;) {
@@ -83,8 +84,9 @@ std::vector<double> fitNonNegative(const std::vector<std::vector<double>>& rows,
 }
 
 void printTable(const std::vector<Sample>& samples, const PrintRates& rates) {
-    std::printf("| part | infill | PrusaSlicer h | estimate h | time error | PrusaSlicer cm³ | estimate cm³ | "
-                "filament error |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::printf(
+        "| part | infill | PrusaSlicer h | estimate h | time error | PrusaSlicer cm³ | estimate cm³ | "
+        "filament error |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
     double worstTime = 0.0, worstMaterial = 0.0, sumTime = 0.0, sumMaterial = 0.0;
     for (const Sample& s : samples) {
         PrintSettings settings;
@@ -95,19 +97,21 @@ void printTable(const std::vector<Sample>& samples, const PrintRates& rates) {
         worstTime = std::max(worstTime, std::abs(te));
         worstMaterial = std::max(worstMaterial, std::abs(me));
         sumTime += te * te, sumMaterial += me * me;
-        std::printf("| %s | %.0f%% | %.2f | %.2f | %+.1f%% | %.1f | %.1f | %+.1f%% |\n", s.name.c_str(), s.infill,
-                    s.slicer.seconds / 3600.0, e.hours(), te, s.slicer.filamentMm3 / 1000.0, e.filamentMm3 / 1000.0, me);
+        std::printf("| %s | %.0f%% | %.2f | %.2f | %+.1f%% | %.1f | %.1f | %+.1f%% |\n", s.name.c_str(),
+                    s.infill, s.slicer.seconds / 3600.0, e.hours(), te, s.slicer.filamentMm3 / 1000.0,
+                    e.filamentMm3 / 1000.0, me);
     }
     const double n = double(samples.size());
-    std::printf("\nlargest |error|: time %.1f%%, filament %.1f%%; rms: time %.1f%%, filament %.1f%%\n", worstTime,
-                worstMaterial, std::sqrt(sumTime / n), std::sqrt(sumMaterial / n));
+    std::printf("\nlargest |error|: time %.1f%%, filament %.1f%%; rms: time %.1f%%, filament %.1f%%\n",
+                worstTime, worstMaterial, std::sqrt(sumTime / n), std::sqrt(sumMaterial / n));
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
     if (!isSlicerAvailable("prusa-slicer")) {
-        std::fprintf(stderr, "report_calibration: prusa-slicer is not installed (apt-get install prusa-slicer)\n");
+        std::fprintf(stderr,
+                     "report_calibration: prusa-slicer is not installed (apt-get install prusa-slicer)\n");
         return 1;
     }
     std::string tsv;
@@ -137,11 +141,17 @@ int main(int argc, char** argv) {
         for (double infill : {20.0, 100.0}) {
             PrintSettings s;
             s.infillPercent = infill;
-            Sample sample{name, infill, &mesh, estimatePrint(mesh, s, unit), sliceWithPrusaSlicer(mesh, s, name),
+            Sample sample{name,
+                          infill,
+                          &mesh,
+                          estimatePrint(mesh, s, unit),
+                          sliceWithPrusaSlicer(mesh, s, name),
                           meshAreaMm2(mesh)};
-            std::fprintf(stderr, "%s %.0f%%: slicer %.0f s %.0f mm3, shell %.0f mm3 infill %.0f mm3 layers %zu\n",
+            std::fprintf(stderr,
+                         "%s %.0f%%: slicer %.0f s %.0f mm3, shell %.0f mm3 infill %.0f mm3 layers %zu\n",
                          name.c_str(), infill, sample.slicer.seconds, sample.slicer.filamentMm3,
-                         sample.model.perimeterMm3 + sample.model.solidMm3, sample.model.infillMm3, sample.model.layers);
+                         sample.model.perimeterMm3 + sample.model.solidMm3, sample.model.infillMm3,
+                         sample.model.layers);
             samples.push_back(sample);
         }
 
@@ -163,7 +173,8 @@ int main(int argc, char** argv) {
     for (const Sample& s : samples) {
         const bool isSolid = s.infill >= 100.0;
         const double infill = s.model.infillMm3 * (isSolid ? 1.0 : fitted.sparseInfillFactor);
-        rows.push_back({s.model.perimeterMm3, s.model.solidMm3, isSolid ? 0.0 : infill, isSolid ? infill : 0.0});
+        rows.push_back(
+            {s.model.perimeterMm3, s.model.solidMm3, isSolid ? 0.0 : infill, isSolid ? infill : 0.0});
         y.push_back(s.slicer.seconds);
     }
     const std::vector<double> x = fitNonNegative(rows, y);
@@ -172,10 +183,11 @@ int main(int argc, char** argv) {
     fitted.sparseInfillSPerMm3 = x[2];
     fitted.solidInfillSPerMm3 = x[3];
 
-    std::printf("fitted: perimeterSPerMm3 %.4f solidSPerMm3 %.4f sparseInfillSPerMm3 %.4f solidInfillSPerMm3 %.4f "
-                "sparseInfillFactor %.4f\n\n",
-                fitted.perimeterSPerMm3, fitted.solidSPerMm3, fitted.sparseInfillSPerMm3, fitted.solidInfillSPerMm3,
-                fitted.sparseInfillFactor);
+    std::printf(
+        "fitted: perimeterSPerMm3 %.4f solidSPerMm3 %.4f sparseInfillSPerMm3 %.4f solidInfillSPerMm3 %.4f "
+        "sparseInfillFactor %.4f\n\n",
+        fitted.perimeterSPerMm3, fitted.solidSPerMm3, fitted.sparseInfillSPerMm3, fitted.solidInfillSPerMm3,
+        fitted.sparseInfillFactor);
     std::printf("## with the fitted rates\n\n");
     printTable(samples, fitted);
     std::printf("\n## with the compiled-in defaults (report::PrintRates{})\n\n");
@@ -183,11 +195,12 @@ int main(int argc, char** argv) {
 
     if (!tsv.empty()) {
         std::ofstream out(tsv);
-        out << "part\tinfill\tslicer_s\tslicer_mm3\tperimeter_mm3\tsolid_mm3\tinfill_mm3\tlayers\tvolume_mm3\tarea_mm2\n";
+        out << "part\tinfill\tslicer_s\tslicer_mm3\tperimeter_mm3\tsolid_mm3\tinfill_mm3\tlayers\tvolume_"
+               "mm3\tarea_mm2\n";
         for (const Sample& s : samples)
-            out << s.name << '\t' << s.infill << '\t' << s.slicer.seconds << '\t' << s.slicer.filamentMm3 << '\t'
-                << s.model.perimeterMm3 << '\t' << s.model.solidMm3
-                << '\t' << s.model.infillMm3 << '\t' << s.model.layers << '\t' << s.model.partVolumeMm3 << '\t' << s.areaMm2 << '\n';
+            out << s.name << '\t' << s.infill << '\t' << s.slicer.seconds << '\t' << s.slicer.filamentMm3
+                << '\t' << s.model.perimeterMm3 << '\t' << s.model.solidMm3 << '\t' << s.model.infillMm3
+                << '\t' << s.model.layers << '\t' << s.model.partVolumeMm3 << '\t' << s.areaMm2 << '\n';
     }
     return 0;
 }

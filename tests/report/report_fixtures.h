@@ -30,13 +30,16 @@ inline TriMesh merged(const TriMesh& a, const TriMesh& b) {
 
 /// A closed box [0, size]³ with a closed cavity @p wallMm inside every face.
 inline TriMesh hollowCube(double sizeMm, double wallMm) {
-    return merged(makeBox({0, 0, 0}, {sizeMm, sizeMm, sizeMm}),
-                  reversed(makeBox({wallMm, wallMm, wallMm}, {sizeMm - wallMm, sizeMm - wallMm, sizeMm - wallMm})));
+    return merged(
+        makeBox({0, 0, 0}, {sizeMm, sizeMm, sizeMm}),
+        reversed(makeBox({wallMm, wallMm, wallMm}, {sizeMm - wallMm, sizeMm - wallMm, sizeMm - wallMm})));
 }
 
 /// A closed spherical shell: outer radius @p radiusMm, wall @p wallMm, centred at @p c.
-inline TriMesh sphereShell(const Vec3d& c, double radiusMm, double wallMm, int rings = 48, int segments = 96) {
-    return merged(makeSphere(c, radiusMm, rings, segments), reversed(makeSphere(c, radiusMm - wallMm, rings, segments)));
+inline TriMesh sphereShell(const Vec3d& c, double radiusMm, double wallMm, int rings = 48,
+                           int segments = 96) {
+    return merged(makeSphere(c, radiusMm, rings, segments),
+                  reversed(makeSphere(c, radiusMm - wallMm, rings, segments)));
 }
 
 /// A piece like the pipeline's: one octant of a spherical shell (outer radius @p radiusMm, wall
@@ -54,8 +57,8 @@ inline TriMesh bunnyMm(double heightMm) {
     transformInPlace(m, Transform4d::yUpToZUp());
     const Box3d b = boundingBox(m);
     const double s = heightMm / (b.max[2] - b.min[2]);
-    transformInPlace(m, Transform4d::scaleTranslate(
-                            s, {-s * 0.5 * (b.min[0] + b.max[0]), -s * 0.5 * (b.min[1] + b.max[1]), -s * b.min[2]}));
+    transformInPlace(m, Transform4d::scaleTranslate(s, {-s * 0.5 * (b.min[0] + b.max[0]),
+                                                        -s * 0.5 * (b.min[1] + b.max[1]), -s * b.min[2]}));
     return m;
 }
 

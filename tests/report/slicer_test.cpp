@@ -2,6 +2,8 @@
 /// @file PrusaSlicer as a subprocess, and the estimator checked against it: within 15 % on time
 /// and filament for a cube, a sphere and a hollow shell piece (the slicer cases are skipped, with
 /// a message, when prusa-slicer is not installed; `make test-deps` installs it).
+#include "zomefab/report/slicer.h"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -11,7 +13,6 @@
 #include "zomefab/core/error.h"
 #include "zomefab/report/cost_report.h"
 #include "zomefab/report/mesh_clip.h"
-#include "zomefab/report/slicer.h"
 
 using namespace zomefab;
 using namespace zomefab::report;

@@ -3,7 +3,6 @@
 /// written by the shipped binary), pieces.json placement back into frame coordinates, stdout, the
 /// Khronos validator, determinism.
 #include <doctest/doctest.h>
-
 #include <sys/wait.h>
 
 #include <cmath>
@@ -11,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <set>
 
 #include "report_fixtures.h"
@@ -18,8 +18,6 @@
 #include "zomefab/core/transform.h"
 #include "zomefab/io/file_io.h"
 #include "zomefab/io/mesh_io.h"
-
-#include <nlohmann/json.hpp>
 
 using namespace zomefab;
 using namespace zomefab::test;
@@ -62,16 +60,17 @@ TEST_CASE("zf-preview: frame and a directory of pieces (STL and GLB)") {
     ScratchDir dir("zf-preview");
     std::filesystem::create_directories(dir.path() / "pieces");
     writeMesh(makeBox({-20, -20, -20}, {0, 0, 0}), dir.file("pieces/piece-00.stl"));
-    std::filesystem::copy_file(std::string(ZOMEFAB_CLI_FIXTURES) + "/tetra.glb", dir.file("pieces/piece-01.glb"));
+    std::filesystem::copy_file(std::string(ZOMEFAB_CLI_FIXTURES) + "/tetra.glb",
+                               dir.file("pieces/piece-01.glb"));
     std::string err;
-    REQUIRE(run(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces") + " -o " + dir.file("p.glb") +
-                " 2>&1",
+    REQUIRE(run(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces") + " -o " +
+                    dir.file("p.glb") + " 2>&1",
                 &err) == 0);
     CHECK(err.find("8 balls, 12 struts, 2 pieces -> ") != std::string::npos);
     const nlohmann::json j = glbJson(readInputBytes(dir.file("p.glb")));
     const std::set<std::string> names = nodeNames(j);
-    for (const char* n : {"zomefab", "pieces", "balls", "struts", "piece-00", "piece-01", "ball-0", "ball-7", "strut-0",
-                          "strut-11"})
+    for (const char* n : {"zomefab", "pieces", "balls", "struts", "piece-00", "piece-01", "ball-0", "ball-7",
+                          "strut-0", "strut-11"})
         CHECK(names.count(n) == 1);
     size_t draco = 0;
     for (const nlohmann::json& m : j["meshes"])
@@ -82,7 +81,8 @@ TEST_CASE("zf-preview: frame and a directory of pieces (STL and GLB)") {
 
     // Deterministic, and "-o -" puts exactly the same bytes on stdout.
     std::string stdoutBytes;
-    REQUIRE(run(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces") + " -o - -q", &stdoutBytes) == 0);
+    REQUIRE(run(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces") + " -o - -q",
+                &stdoutBytes) == 0);
     CHECK(stdoutBytes == readInputBytes(dir.file("p.glb")));
 
     if (run("command -v node > /dev/null 2>&1") != 0) {
@@ -91,8 +91,8 @@ TEST_CASE("zf-preview: frame and a directory of pieces (STL and GLB)") {
     }
     const char* env = std::getenv("ZOMEFAB_NODE_DIR");
     std::string summary;
-    const int code = run("node '" + std::string(ZOMEFAB_VALIDATOR_SCRIPT) + "' '" + (env ? env : ZOMEFAB_NODE_DIR) +
-                             "' '" + dir.file("p.glb") + "' 2>&1",
+    const int code = run("node '" + std::string(ZOMEFAB_VALIDATOR_SCRIPT) + "' '" +
+                             (env ? env : ZOMEFAB_NODE_DIR) + "' '" + dir.file("p.glb") + "' 2>&1",
                          &summary);
     INFO("validator: " << summary);
     REQUIRE(code != 2);  // 2 = the validator is not installed: run `make test-deps`
@@ -116,17 +116,20 @@ TEST_CASE("zf-preview: pieces.json pieces go back from the printer to the frame'
         for (int r = 0; r < 4; ++r) rows.push_back({t.at(r, 0), t.at(r, 1), t.at(r, 2), t.at(r, 3)});
         return rows;
     };
-    const nlohmann::json pieces = {
-        {"format", "zomefab.pieces"},
-        {"version", 1},
-        {"frame_to_grid_mm", matrix(frameToGrid)},
-        {"pieces", {{{"piece", 0}, {"file", "piece-00.stl"}, {"orientation", {{"transform_mm", matrix(gridToPrint)}}}}}}};
+    const nlohmann::json pieces = {{"format", "zomefab.pieces"},
+                                   {"version", 1},
+                                   {"frame_to_grid_mm", matrix(frameToGrid)},
+                                   {"pieces",
+                                    {{{"piece", 0},
+                                      {"file", "piece-00.stl"},
+                                      {"orientation", {{"transform_mm", matrix(gridToPrint)}}}}}}};
     writeBytes(dir.file("pieces.json"), pieces.dump());
     REQUIRE(run(preview() + " " + cubeFrame() + " --pieces " + dir.path().string() + " --no-draco -o " +
                 dir.file("p.glb") + " -q") == 0);
     const nlohmann::json j = glbJson(readInputBytes(dir.file("p.glb")));
     CHECK(!j.contains("extensionsUsed"));
-    const nlohmann::json& accessor = j["accessors"][j["meshes"][0]["primitives"][0]["attributes"]["POSITION"].get<size_t>()];
+    const nlohmann::json& accessor =
+        j["accessors"][j["meshes"][0]["primitives"][0]["attributes"]["POSITION"].get<size_t>()];
     const std::vector<double> lo = accessor["min"], hi = accessor["max"];
     CHECK(lo[0] == doctest::Approx(10.0));
     CHECK(lo[1] == doctest::Approx(0.0));
@@ -134,10 +137,11 @@ TEST_CASE("zf-preview: pieces.json pieces go back from the printer to the frame'
     CHECK(hi[1] == doctest::Approx(20.0));
     CHECK(hi[2] == doctest::Approx(5.0));
 
-    writeBytes(dir.file("pieces.json"), R"({"format": "zomefab.pieces", "version": 1, "pieces": [{"piece": 0}]})");
+    writeBytes(dir.file("pieces.json"),
+               R"({"format": "zomefab.pieces", "version": 1, "pieces": [{"piece": 0}]})");
     std::string err;
-    CHECK(run(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces.json") + " -o " + dir.file("bad.glb") +
-                  " 2>&1",
+    CHECK(run(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces.json") + " -o " +
+                  dir.file("bad.glb") + " 2>&1",
               &err) == 2);
     CHECK(err.find("pieces.json: pieces[0] has no file") != std::string::npos);
     CHECK(!std::filesystem::exists(dir.file("bad.glb")));

@@ -57,7 +57,8 @@ void validateScene(const GlbScene& scene, const GlbWriteOptions& options) {
     for (size_t i = 0; i < scene.materials.size(); ++i) {
         const GlbMaterial& m = scene.materials[i];
         for (double c : m.baseColor)
-            if (!(c >= 0.0 && c <= 1.0)) invalid("material " + std::to_string(i) + " has a colour outside [0, 1]");
+            if (!(c >= 0.0 && c <= 1.0))
+                invalid("material " + std::to_string(i) + " has a colour outside [0, 1]");
         if (!(m.metallic >= 0.0 && m.metallic <= 1.0) || !(m.roughness >= 0.0 && m.roughness <= 1.0))
             invalid("material " + std::to_string(i) + " has metallic or roughness outside [0, 1]");
     }
@@ -90,7 +91,8 @@ void validateScene(const GlbScene& scene, const GlbWriteOptions& options) {
     for (size_t i = 0; i < scene.nodes.size(); ++i) {
         const GlbNode& n = scene.nodes[i];
         if (n.mesh < -1 || n.mesh >= int(scene.meshes.size()))
-            invalid(nodeLabel(scene, i) + " refers to mesh " + std::to_string(n.mesh) + ", which does not exist");
+            invalid(nodeLabel(scene, i) + " refers to mesh " + std::to_string(n.mesh) +
+                    ", which does not exist");
         for (double v : n.translation)
             if (!std::isfinite(v)) invalid(nodeLabel(scene, i) + " has a non-finite translation");
         for (double v : n.scale)
@@ -168,7 +170,8 @@ nlohmann::json writePlainPrimitive(const GlbMesh& mesh, BinaryBuilder& bin, nloh
     const TriMesh& g = mesh.geometry;
     nlohmann::json attributes;
     nlohmann::json position = vec3Accessor(g.positions.size());
-    position["bufferView"] = bin.addView(g.positions.data(), g.positions.size() * sizeof(Vec3f), kArrayBuffer, views);
+    position["bufferView"] =
+        bin.addView(g.positions.data(), g.positions.size() * sizeof(Vec3f), kArrayBuffer, views);
     addBounds(position, g.positions);
     accessors.push_back(std::move(position));
     attributes["POSITION"] = accessors.size() - 1;
@@ -187,11 +190,12 @@ nlohmann::json writePlainPrimitive(const GlbMesh& mesh, BinaryBuilder& bin, nloh
         for (const Triangle& t : g.triangles)
             for (uint32_t v : t) idx.push_back(uint16_t(v));
         index["componentType"] = kUnsignedShort;
-        index["bufferView"] = bin.addView(idx.data(), idx.size() * sizeof(uint16_t), kElementArrayBuffer, views);
+        index["bufferView"] =
+            bin.addView(idx.data(), idx.size() * sizeof(uint16_t), kElementArrayBuffer, views);
     } else {
         index["componentType"] = kUnsignedInt;
-        index["bufferView"] =
-            bin.addView(g.triangles.data(), g.triangles.size() * sizeof(Triangle), kElementArrayBuffer, views);
+        index["bufferView"] = bin.addView(g.triangles.data(), g.triangles.size() * sizeof(Triangle),
+                                          kElementArrayBuffer, views);
     }
     accessors.push_back(std::move(index));
     return {{"attributes", std::move(attributes)}, {"indices", accessors.size() - 1}, {"mode", kTriangles}};
@@ -199,8 +203,9 @@ nlohmann::json writePlainPrimitive(const GlbMesh& mesh, BinaryBuilder& bin, nloh
 
 /// Encodes @p mesh with Draco, decodes it again, and writes the KHR_draco_mesh_compression
 /// primitive whose accessors describe the decoded mesh (count, bounds) and have no bufferView.
-nlohmann::json writeDracoPrimitive(const GlbMesh& mesh, const std::string& label, const GlbWriteOptions& options,
-                                   BinaryBuilder& bin, nlohmann::json& views, nlohmann::json& accessors) {
+nlohmann::json writeDracoPrimitive(const GlbMesh& mesh, const std::string& label,
+                                   const GlbWriteOptions& options, BinaryBuilder& bin, nlohmann::json& views,
+                                   nlohmann::json& accessors) {
     const TriMesh& g = mesh.geometry;
     draco::Mesh dm;
     dm.set_num_points(uint32_t(g.positions.size()));
@@ -231,7 +236,8 @@ nlohmann::json writeDracoPrimitive(const GlbMesh& mesh, const std::string& label
     draco::EncoderBuffer encoded;
     const draco::Status status = encoder.EncodeMeshToBuffer(dm, &encoded);
     if (!status.ok())
-        throw Error(ErrorCode::ProcessingFailed, "Draco cannot encode " + label + ": " + status.error_msg_string());
+        throw Error(ErrorCode::ProcessingFailed,
+                    "Draco cannot encode " + label + ": " + status.error_msg_string());
 
     // Decode what we wrote: Draco may drop degenerate faces and unreferenced vertices and split
     // non-manifold ones, and quantisation moves positions, so counts and bounds come from here.
@@ -240,12 +246,13 @@ nlohmann::json writeDracoPrimitive(const GlbMesh& mesh, const std::string& label
     draco::Decoder decoder;
     auto decoded = decoder.DecodeMeshFromBuffer(&in);
     if (!decoded.ok())
-        throw Error(ErrorCode::ProcessingFailed,
-                    "Draco cannot decode its own encoding of " + label + ": " + decoded.status().error_msg_string());
+        throw Error(ErrorCode::ProcessingFailed, "Draco cannot decode its own encoding of " + label + ": " +
+                                                     decoded.status().error_msg_string());
     const std::unique_ptr<draco::Mesh> back = std::move(decoded).value();
     const draco::PointAttribute* pos = back->GetAttributeByUniqueId(positionId);
     if (!pos || back->num_points() == 0 || back->num_faces() == 0)
-        throw Error(ErrorCode::ProcessingFailed, "Draco dropped every triangle of " + label + " (degenerate mesh)");
+        throw Error(ErrorCode::ProcessingFailed,
+                    "Draco dropped every triangle of " + label + " (degenerate mesh)");
     std::vector<Vec3f> decodedPositions(back->num_points());
     for (uint32_t p = 0; p < back->num_points(); ++p)
         pos->GetMappedValue(draco::PointIndex(p), decodedPositions[p].data());
@@ -268,7 +275,8 @@ nlohmann::json writeDracoPrimitive(const GlbMesh& mesh, const std::string& label
     return {{"attributes", std::move(attributes)},
             {"indices", accessors.size() - 1},
             {"mode", kTriangles},
-            {"extensions", {{kDracoExtension, {{"bufferView", view}, {"attributes", std::move(dracoAttributes)}}}}}};
+            {"extensions",
+             {{kDracoExtension, {{"bufferView", view}, {"attributes", std::move(dracoAttributes)}}}}}};
 }
 
 template <typename T>
@@ -293,9 +301,10 @@ std::string serializeGlb(const GlbScene& scene, const GlbWriteOptions& options) 
     bool usesDraco = false;
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const GlbMesh& mesh = scene.meshes[m];
-        nlohmann::json primitive = mesh.isDracoCompressed
-                                       ? writeDracoPrimitive(mesh, meshLabel(scene, m), options, bin, views, accessors)
-                                       : writePlainPrimitive(mesh, bin, views, accessors);
+        nlohmann::json primitive =
+            mesh.isDracoCompressed
+                ? writeDracoPrimitive(mesh, meshLabel(scene, m), options, bin, views, accessors)
+                : writePlainPrimitive(mesh, bin, views, accessors);
         usesDraco = usesDraco || mesh.isDracoCompressed;
         if (mesh.material >= 0) primitive["material"] = mesh.material;
         nlohmann::json entry = {{"primitives", nlohmann::json::array({std::move(primitive)})}};
@@ -367,7 +376,8 @@ std::string serializeGlb(const GlbScene& scene, const GlbWriteOptions& options) 
 
 void writeGlb(const GlbScene& scene, const std::string& path, const GlbWriteOptions& options) {
     const std::string bytes = serializeGlb(scene, options);
-    writeOutputAtomic(path, [&](std::ostream& out) { out.write(bytes.data(), std::streamsize(bytes.size())); });
+    writeOutputAtomic(path,
+                      [&](std::ostream& out) { out.write(bytes.data(), std::streamsize(bytes.size())); });
 }
 
 }  // namespace zomefab

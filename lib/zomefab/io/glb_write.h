@@ -21,17 +21,17 @@ namespace zomefab {
 struct GlbMaterial {
     std::string name;
     std::array<double, 4> baseColor{1.0, 1.0, 1.0, 1.0};  ///< linear RGBA, each in [0, 1]
-    double metallic = 0.0;   ///< [0, 1]
-    double roughness = 0.6;  ///< [0, 1]
+    double metallic = 0.0;                                ///< [0, 1]
+    double roughness = 0.6;                               ///< [0, 1]
 };
 
 /// One mesh = one indexed triangle primitive. Several nodes may refer to the same mesh.
 struct GlbMesh {
     std::string name;
-    TriMesh geometry;            ///< positions in the scene's length unit, outward triangles
+    TriMesh geometry;  ///< positions in the scene's length unit, outward triangles
     /// Empty (viewers then compute flat normals, glTF 2.0 §3.7.2.1) or one unit normal per vertex.
     std::vector<Vec3f> normals;
-    int material = -1;           ///< index into GlbScene::materials; -1 = glTF's default material
+    int material = -1;  ///< index into GlbScene::materials; -1 = glTF's default material
     /// Store the primitive as a Draco bitstream (KHR_draco_mesh_compression): positions quantised
     /// to GlbWriteOptions::dracoPositionBits, vertex order and count chosen by Draco.
     bool isDracoCompressed = false;
@@ -40,12 +40,12 @@ struct GlbMesh {
 /// A node: an optional mesh, children, and a local transform T·R·S (glTF 2.0 §3.5.3).
 struct GlbNode {
     std::string name;
-    int mesh = -1;                               ///< index into GlbScene::meshes, -1 = none
-    std::vector<int> children;                   ///< node indices
+    int mesh = -1;              ///< index into GlbScene::meshes, -1 = none
+    std::vector<int> children;  ///< node indices
     Vec3d translation{0.0, 0.0, 0.0};
     std::array<double, 4> rotation{0.0, 0.0, 0.0, 1.0};  ///< unit quaternion (x, y, z, w)
     Vec3d scale{1.0, 1.0, 1.0};
-    nlohmann::json extras;                       ///< null = no `extras`
+    nlohmann::json extras;  ///< null = no `extras`
 };
 
 /// One scene: the nodes listed in @c roots and everything below them.
@@ -53,10 +53,10 @@ struct GlbScene {
     std::vector<GlbMaterial> materials;
     std::vector<GlbMesh> meshes;
     std::vector<GlbNode> nodes;
-    std::vector<int> roots;      ///< root node indices of scenes[0]
+    std::vector<int> roots;  ///< root node indices of scenes[0]
     std::string sceneName;
-    nlohmann::json extras;       ///< scenes[0].extras; null = none
-    std::string generator;       ///< asset.generator, e.g. "zomefab 0.1.0"
+    nlohmann::json extras;  ///< scenes[0].extras; null = none
+    std::string generator;  ///< asset.generator, e.g. "zomefab 0.1.0"
 };
 
 /// Draco settings for meshes with GlbMesh::isDracoCompressed.
@@ -64,7 +64,7 @@ struct GlbWriteOptions {
     /// Position quantisation (bits per coordinate over the mesh's bounding box): 14 bits keep a
     /// 200 mm piece within 0.012 mm, well below a 0.2 mm print layer. Draco allows 1..30.
     int dracoPositionBits = 14;
-    int dracoNormalBits = 10;     ///< normal quantisation (octahedral), 1..30
+    int dracoNormalBits = 10;  ///< normal quantisation (octahedral), 1..30
     /// Draco speed options 0 (smallest file, slowest) .. 10 (fastest); 3 = draco_encoder's `-cl 7`.
     int dracoEncodingSpeed = 3;
     int dracoDecodingSpeed = 3;

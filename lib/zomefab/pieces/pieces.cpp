@@ -389,9 +389,9 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
         throw Error(ErrorCode::Usage, "tenon pegs " + number(pegShortMm(opt.tenons)) + " mm thick need a voxel of at most " +
                                           number(0.5 * pegShortMm(opt.tenons)) + " mm, but the shell's voxel is " +
                                           number(voxel) + " mm: rebuild it finer (zf-sdf --voxel-mm) or turn tenons off");
-    if (opt.label.isEnabled && opt.label.strokeMm < 1.5 * voxel) {
+    if (opt.label.isEnabled && opt.label.strokeMm < 2.0 * voxel) {
         context.warn("piece numbers are not engraved: a " + number(opt.label.strokeMm) + " mm stroke needs a voxel of at most " +
-                     number(opt.label.strokeMm / 1.5) + " mm (the shell's is " + number(voxel) + " mm)");
+                     number(opt.label.strokeMm / 2.0) + " mm (the shell's is " + number(voxel) + " mm)");
         opt.label.isEnabled = false;
     }
 
@@ -828,7 +828,10 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
             }
             openvdb::tools::pruneLevelSet(grid->tree());
             grids[p] = std::move(grid);
-            if (!mask->empty()) fullResolution[p] = std::move(mask);
+            if (!mask->empty()) {
+                mask->voxelizeActiveTiles();  // the mesher looks the mask up by leaf nodes only
+                fullResolution[p] = std::move(mask);
+            }
         }
     });
     context.throwIfCancelled();

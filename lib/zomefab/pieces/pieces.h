@@ -54,7 +54,8 @@ struct PiecesOptions {
     /// Build volume of the printer (paper: Ultimaker 3, 200 mm cube), any order of the sides.
     Vec3d printerMm{200.0, 200.0, 200.0};
     /// volumeToMesh adaptivity: 0 = one vertex per surface voxel; larger merges flat regions into
-    /// larger triangles. 0.3 keeps the bunny's pieces at 400 mm near 3 MB of STL (docs/pieces.md).
+    /// larger triangles (tenons and numbers stay at full resolution). 0.3 gives the bunny at 400 mm
+    /// 24 MB of STL where 0 gives 121 MB (docs/pieces.md).
     double adaptivity = 0.3;
 };
 

@@ -10,6 +10,7 @@
 #include "zomefab/frame/outermost.h"
 #include "zomefab/io/file_io.h"
 #include "zomefab/partition/partition_json.h"
+#include "zomefab/pieces/pieces_io.h"
 #include "zomefab/sdf/interior_field.h"
 #include "zomefab/zome/parts.h"
 #include "zomefab/zome/structure_json.h"
@@ -53,6 +54,7 @@ void checkRunOptions(const RunOptions& options) {
     sdf::checkObjectFieldOptions(options.field);
     sdf::checkShellOptions(options.shell);
     partition::checkPartitionOptions(options.partition, options.frame.lattice.scale);
+    pieces::checkPiecesOptions(options.pieces);
     if (options.frame.chains < 1) throw Error(ErrorCode::Usage, "--chains must be at least 1");
 }
 
@@ -124,6 +126,20 @@ RunResult runPipeline(const TriMesh& input, const std::string& sourceName, const
         }
     });
 
+    // Stage 6: printable pieces (paper §6): the shell cut by the partition's cells, with tenons.
+    result.pieces = timedStage("pieces", result, context, [&] {
+        pieces::CellModel cells;
+        cells.w = result.partition.cells.w;
+        cells.b = result.partition.cells.b;
+        std::vector<pieces::PieceRequest> requests;
+        for (const partition::Piece& piece : result.partition.pieces) requests.push_back({piece.cells, piece.boundsMm});
+        pieces::PiecesOptions piecesOptions = options.pieces;
+        piecesOptions.printerMm = options.partition.printerMm;
+        const Transform4d frameToGridMm = result.shell.info().transformMm * affineInverse(result.frameTransformMm);
+        return pieces::makePieces(result.shell, result.frame.structure, frameToGridMm, cells, requests,
+                                  piecesOptions, context);
+    });
+
     result.totalSeconds = total.seconds();
     return result;
 }
@@ -160,6 +176,17 @@ nlohmann::json runReportJson(const RunResult& result, const RunOptions& options,
                            {"energy_nearest", result.partition.energyNearest},
                            {"energy_graph_cut", result.partition.energyGraphCut},
                            {"printer_mm", result.partition.printerMm}};
+    size_t tenons = 0;
+    double piecesVolumeMm3 = 0;
+    for (const pieces::Piece& piece : result.pieces.pieces) {
+        tenons += piece.tenons.size();
+        piecesVolumeMm3 += piece.volumeMm3;
+    }
+    report["pieces"] = {{"count", result.pieces.pieces.size()},
+                        {"tenons", tenons},
+                        {"volume_mm3", piecesVolumeMm3},
+                        {"shell_volume_mm3", result.pieces.shellVolumeMm3},
+                        {"slivers_merged", result.pieces.sliversMerged}};
     nlohmann::json timings = nlohmann::json::array();
     for (const StageTiming& t : result.timings) timings.push_back({{"stage", t.stage}, {"seconds", t.seconds}});
     report["timings"] = timings;
@@ -188,6 +215,8 @@ std::vector<std::string> writeRunOutputs(const RunResult& result, const RunOptio
         info.vertexCount = result.surfaceFrameMm.vertexCount();
         out << partition::partitionToJson(result.partition, options.partition, info).dump(1) << '\n';
     });
+    pieces::writePieces(result.pieces, staged.file("pieces"), {result.sourceName, "frame.json", "partition.json"});
+    written.push_back("pieces/");
     write(kReportFile, [&](std::ostream& out) { out << report.dump(2) << '\n'; });
     staged.commit();
     std::sort(written.begin(), written.end());

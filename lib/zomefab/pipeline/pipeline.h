@@ -14,6 +14,7 @@
 #include "zomefab/mesh/mesh_check.h"
 #include "zomefab/mesh/scale.h"
 #include "zomefab/partition/partition.h"
+#include "zomefab/pieces/pieces.h"
 #include "zomefab/sdf/level_set.h"
 
 namespace zomefab::pipeline {
@@ -25,6 +26,7 @@ struct RunOptions {
     sdf::ShellOptions shell;         ///< wall thickness (paper §6: dMin = 16 mm)
     frame::FrameOptions frame;       ///< chains, seed, annealing budget (paper §4)
     partition::PartitionOptions partition;  ///< printer size, saliency (paper §5)
+    pieces::PiecesOptions pieces;    ///< tenons, slivers, meshing; printer size from partition
 };
 
 /// Seconds spent in each stage, in run order.
@@ -45,6 +47,7 @@ struct RunResult {
     frame::FrameMetrics frameMetrics;
     TriMesh surfaceFrameMm;            ///< the scaled surface in the frame's coordinates
     partition::PartitionResult partition;
+    pieces::Pieces pieces;             ///< printable pieces, in printer coordinates
     std::vector<StageTiming> timings;
     double totalSeconds = 0;
 };

@@ -36,8 +36,8 @@ struct StrutStep {
 struct BallStep {
     zome::BallId ball = 0;
     Vec3d positionMm{};
-    size_t layer = 0;       ///< breadth-first distance (in struts) from its component's start ball
-    size_t component = 0;   ///< 0 for a connected frame
+    size_t layer = 0;               ///< breadth-first distance (in struts) from its component's start ball
+    size_t component = 0;           ///< 0 for a connected frame
     std::vector<StrutStep> struts;  ///< sorted by colour, size, hole
 };
 
@@ -49,9 +49,9 @@ struct PieceStep {
 
 struct AssemblyGuide {
     zome::PartsList parts;
-    std::vector<BallStep> steps;  ///< every live ball exactly once, in build order
-    size_t layers = 0;            ///< number of layers of the largest component
-    size_t components = 0;        ///< connected components of the frame
+    std::vector<BallStep> steps;    ///< every live ball exactly once, in build order
+    size_t layers = 0;              ///< number of layers of the largest component
+    size_t components = 0;          ///< connected components of the frame
     std::vector<PieceStep> pieces;  ///< pieces in order of first appearance in the tenon list
 };
 

@@ -34,30 +34,37 @@ nlohmann::json printJson(const PrintEstimate& e) {
 }
 
 nlohmann::json fabricationJson(const Fabrication& f) {
-    return {{"print", printJson(f.print)},
-            {"filament", {{"length_m", f.filament.lengthM}, {"mass_g", f.filament.massG}, {"cost_usd", f.filament.costUsd}}},
-            {"assembly_hours", f.assemblyHours},
-            {"zometool_usd", f.zomeUsd},
-            {"total_hours", f.totalHours()},
-            {"total_usd", f.totalUsd()}};
+    return {
+        {"print", printJson(f.print)},
+        {"filament",
+         {{"length_m", f.filament.lengthM}, {"mass_g", f.filament.massG}, {"cost_usd", f.filament.costUsd}}},
+        {"assembly_hours", f.assemblyHours},
+        {"zometool_usd", f.zomeUsd},
+        {"total_hours", f.totalHours()},
+        {"total_usd", f.totalUsd()}};
 }
 
 }  // namespace
 
 double assemblyHours(const zome::PartsList& parts, const AssemblyTimeOptions& options) {
-    return (double(parts.strutTotal()) * options.secondsPerStrut + double(parts.balls) * options.secondsPerBall) / 3600.0;
+    return (double(parts.strutTotal()) * options.secondsPerStrut +
+            double(parts.balls) * options.secondsPerBall) /
+           3600.0;
 }
 
 const char* estimateSourceName(EstimateSource source) {
     return source == EstimateSource::PrusaSlicer ? "prusa-slicer" : "estimator";
 }
 
-CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piecesMm, const zome::PartsList& parts,
-                      const CostOptions& options, RunContext& context) {
+CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piecesMm,
+                      const zome::PartsList& parts, const CostOptions& options, RunContext& context) {
     options.print.validate();
     options.filament.validate();
     if (!(options.assembly.secondsPerStrut >= 0.0) || !(options.assembly.secondsPerBall >= 0.0))
         throw Error(ErrorCode::Usage, "assembly seconds per strut and per ball must not be negative");
+    if (options.source == EstimateSource::PrusaSlicer && !isSlicerAvailable(options.slicer.executable))
+        throw Error(ErrorCode::Usage, "--slicer " + options.slicer.executable +
+                                          ": not installed or not executable (Debian package prusa-slicer)");
     CostReport report;
     report.options = options;
     report.source = options.source;
@@ -74,11 +81,13 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piece
     const double buildHours = assemblyHours(parts, options.assembly);
     const size_t total = 2 * (piecesMm.size() + baselineParts.size());
     size_t done = 0;
-    auto printAll = [&](const std::vector<TriMesh>& meshes, const PrintSettings& settings, const std::string& what) {
+    auto printAll = [&](const std::vector<TriMesh>& meshes, const PrintSettings& settings,
+                        const std::string& what) {
         PrintEstimate sum;
         for (size_t i = 0; i < meshes.size(); ++i) {
             context.throwIfCancelled();
-            const std::string label = what + " " + std::to_string(i) + " at " + fixed(settings.infillPercent, 0) + "%";
+            const std::string label =
+                what + " " + std::to_string(i) + " at " + fixed(settings.infillPercent, 0) + "%";
             if (options.source == EstimateSource::PrusaSlicer) {
                 try {
                     sum += sliceWithPrusaSlicer(meshes[i], settings, label, options.slicer, context);
@@ -156,26 +165,29 @@ nlohmann::json costReportToJson(const CostReport& r) {
 }
 
 std::string costReportMarkdown(const CostReport& r) {
-    std::string md = "| infill | method | printing (h) | Zometool assembly (h) | overall (h) | printing (USD) | "
-                     "Zometool (USD) | overall (USD) | time saved | material saved |\n"
-                     "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    std::string md =
+        "| infill | method | printing (h) | Zometool assembly (h) | overall (h) | printing (USD) | "
+        "Zometool (USD) | overall (USD) | time saved | material saved |\n"
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const CostCase& c : r.cases) {
         const std::string label = c.name + " (" + fixed(c.infillPercent, 0) + "%)";
-        md += "| " + label + " | ZomeFab | " + fixed(c.zomefab.print.hours()) + " | " + fixed(c.zomefab.assemblyHours) +
-              " | " + fixed(c.zomefab.totalHours()) + " | " + fixed(c.zomefab.filament.costUsd) + " | " +
-              fixed(c.zomefab.zomeUsd) + " | " + fixed(c.zomefab.totalUsd()) + " | " + fixed(c.savedTimePercent) +
-              "% | " + fixed(c.savedMaterialPercent) + "% |\n";
+        md += "| " + label + " | ZomeFab | " + fixed(c.zomefab.print.hours()) + " | " +
+              fixed(c.zomefab.assemblyHours) + " | " + fixed(c.zomefab.totalHours()) + " | " +
+              fixed(c.zomefab.filament.costUsd) + " | " + fixed(c.zomefab.zomeUsd) + " | " +
+              fixed(c.zomefab.totalUsd()) + " | " + fixed(c.savedTimePercent) + "% | " +
+              fixed(c.savedMaterialPercent) + "% |\n";
         md += "| | baseline (" + std::to_string(c.baseline.print.parts) + " octree parts) | " +
               fixed(c.baseline.print.hours()) + " | | " + fixed(c.baseline.totalHours()) + " | " +
               fixed(c.baseline.filament.costUsd) + " | | " + fixed(c.baseline.totalUsd()) + " | | |\n";
     }
-    md += "\nFilament (" + fixed(r.options.filament.diameterMm) + " mm, " + fixed(r.options.filament.usdPerM) +
-          " USD/m): ";
+    md += "\nFilament (" + fixed(r.options.filament.diameterMm) + " mm, " +
+          fixed(r.options.filament.usdPerM) + " USD/m): ";
     for (size_t i = 0; i < r.cases.size(); ++i) {
         const CostCase& c = r.cases[i];
         md += (i ? "; " : "") + c.name + " ZomeFab " + fixed(c.zomefab.filament.lengthM, 1) + " m / " +
-              fixed(c.zomefab.filament.massG, 0) + " g, baseline " + fixed(c.baseline.filament.lengthM, 1) + " m / " +
-              fixed(c.baseline.filament.massG, 0) + " g (" + fixed(c.savedFilamentPercent, 1) + "% less plastic)";
+              fixed(c.zomefab.filament.massG, 0) + " g, baseline " + fixed(c.baseline.filament.lengthM, 1) +
+              " m / " + fixed(c.baseline.filament.massG, 0) + " g (" + fixed(c.savedFilamentPercent, 1) +
+              "% less plastic)";
     }
     md += ". Times and filament from the " + std::string(estimateSourceName(r.source)) + ".\n";
     return md;

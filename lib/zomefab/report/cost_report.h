@@ -37,17 +37,17 @@ struct CostOptions {
     double solidInfillPercent = 100.0;  ///< the paper's "solid" case
     PrintRates rates;
     FilamentOptions filament;
-    zome::PriceOptions prices;          ///< Zometool prices (0.19 USD a strut, 0.29 USD a ball)
+    zome::PriceOptions prices;  ///< Zometool prices (0.19 USD a strut, 0.29 USD a ball)
     AssemblyTimeOptions assembly;
     Vec3d printerMm{200.0, 200.0, 200.0};  ///< printer volume; Ultimaker 3 in the paper (§7.1)
     EstimateSource source = EstimateSource::Estimator;
-    SlicerOptions slicer;               ///< used when source == PrusaSlicer
+    SlicerOptions slicer;  ///< used when source == PrusaSlicer
 };
 
 /// One way of making the object.
 struct Fabrication {
-    PrintEstimate print;       ///< summed over the printed parts
-    FilamentUse filament;      ///< of print.filamentMm3
+    PrintEstimate print;         ///< summed over the printed parts
+    FilamentUse filament;        ///< of print.filamentMm3
     double assemblyHours = 0.0;  ///< building the frame (0 for the baseline)
     double zomeUsd = 0.0;        ///< Zometool parts (0 for the baseline)
 
@@ -69,7 +69,7 @@ struct CostCase {
 };
 
 struct CostReport {
-    std::vector<CostCase> cases;      ///< hollow, then solid
+    std::vector<CostCase> cases;  ///< hollow, then solid
     size_t pieceCount = 0;
     size_t baselinePartCount = 0;
     double objectVolumeMm3 = 0.0;
@@ -79,7 +79,7 @@ struct CostReport {
     /// Parts the slicer failed on (e.g. "baseline part 3 at 20%"), estimated instead, each with a
     /// warning on the run context.
     std::vector<std::string> slicerFallbacks;
-    CostOptions options;              ///< the options used, echoed into the JSON
+    CostOptions options;  ///< the options used, echoed into the JSON
 };
 
 /// Builds the report. @p objectMm is the closed input object in mm as it would be printed whole
@@ -87,9 +87,11 @@ struct CostReport {
 /// frame's parts list. With EstimateSource::PrusaSlicer every piece and baseline part is sliced
 /// (2 × (pieces + parts) slicer runs; progress through @p context); a part the slicer fails on is
 /// estimated instead, with a warning, and listed in CostReport::slicerFallbacks.
-/// @throw Error(Usage) for invalid options, as octreeParts() and sliceWithPrusaSlicer().
-CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piecesMm, const zome::PartsList& parts,
-                      const CostOptions& options = {}, RunContext& context = RunContext::silent());
+/// @throw Error(Usage) for invalid options or a slicer that is not installed, as octreeParts(),
+///   Error(Cancelled).
+CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piecesMm,
+                      const zome::PartsList& parts, const CostOptions& options = {},
+                      RunContext& context = RunContext::silent());
 
 /// The report as JSON (report.json's "cost" block): every number with its unit in the key.
 nlohmann::json costReportToJson(const CostReport& report);

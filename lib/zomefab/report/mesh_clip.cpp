@@ -82,7 +82,8 @@ void bridgeHole(std::vector<CapVertex>& outer, const std::vector<CapVertex>& hol
     for (size_t i = 0; i < outer.size(); ++i) {
         const CapVertex& r = outer[i];
         if (i == p || r.u < M.u) continue;
-        const CapVertex &prev = outer[(i + outer.size() - 1) % outer.size()], &next = outer[(i + 1) % outer.size()];
+        const CapVertex &prev = outer[(i + outer.size() - 1) % outer.size()],
+                        &next = outer[(i + 1) % outer.size()];
         if (cross(prev, r, next) > 0.0) continue;  // convex vertices cannot block
         const bool inside = isCcw ? inTriangle(r, M, I, P) : inTriangle(r, M, P, I);
         if (!inside) continue;
@@ -285,7 +286,8 @@ TriMesh clipByPlane(const TriMesh& mesh, int axis, double coordMm, bool keepBelo
         size_t best = outers.size();
         const CapVertex& probe = holes[h][0];
         for (size_t o = 0; o < outers.size(); ++o)
-            if ((best == outers.size() || outerAreas[o] < outerAreas[best]) && contains(outers[o], probe.u, probe.v))
+            if ((best == outers.size() || outerAreas[o] < outerAreas[best]) &&
+                contains(outers[o], probe.u, probe.v))
                 best = o;
         if (best == outers.size()) capFailed("a hole of the cross-section lies outside every outer loop");
         holesOf[best].push_back(h);

@@ -82,12 +82,13 @@ std::array<double, 4> quaternionFromColumns(const Mat3& m) {
 /// Icosphere of radius @p r: smooth normals, 20·4^levels triangles, outward.
 GlbMesh sphereMesh(double r, int levels) {
     const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    std::vector<Vec3d> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                            {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    std::vector<Vec3d> p = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                            {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
     for (Vec3d& v : p) v = normalized(v);
-    std::vector<Triangle> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                               {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                               {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+    std::vector<Triangle> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                               {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                               {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                               {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
     for (int level = 0; level < levels; ++level) {
         std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
         auto midpoint = [&](uint32_t a, uint32_t b) {
@@ -102,7 +103,8 @@ GlbMesh sphereMesh(double r, int levels) {
         std::vector<Triangle> next;
         next.reserve(f.size() * 4);
         for (const Triangle& tri : f) {
-            const uint32_t a = midpoint(tri[0], tri[1]), b = midpoint(tri[1], tri[2]), c = midpoint(tri[2], tri[0]);
+            const uint32_t a = midpoint(tri[0], tri[1]), b = midpoint(tri[1], tri[2]),
+                           c = midpoint(tri[2], tri[0]);
             next.push_back({tri[0], a, c});
             next.push_back({tri[1], b, a});
             next.push_back({tri[2], c, b});
@@ -122,7 +124,8 @@ GlbMesh sphereMesh(double r, int levels) {
 
 /// Prism of @p section (counter-clockwise, mm) from z = 0 to z = @p lengthMm, flat-shaded (each
 /// face has its own vertices).
-GlbMesh prismMesh(const std::string& name, const std::vector<std::array<double, 2>>& section, double lengthMm) {
+GlbMesh prismMesh(const std::string& name, const std::vector<std::array<double, 2>>& section,
+                  double lengthMm) {
     GlbMesh mesh;
     mesh.name = name;
     TriMesh& g = mesh.geometry;
@@ -185,7 +188,8 @@ std::vector<std::array<double, 2>> strutCrossSection(zome::Color color) {
 
 Vec3d strutCrossSectionFrame(int hole) {
     const Vec3d d = zome::holeDirection(hole);
-    const zome::Color target = zome::holeColor(hole) == zome::Color::Red ? zome::Color::Yellow : zome::Color::Red;
+    const zome::Color target =
+        zome::holeColor(hole) == zome::Color::Red ? zome::Color::Yellow : zome::Color::Red;
     const auto [first, last] = zome::holeRange(target);
     double best = -2.0;
     Vec3d u{};
@@ -202,11 +206,13 @@ Vec3d strutCrossSectionFrame(int hole) {
 
 GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& options) {
     if (!input.pieceNames.empty() && input.pieceNames.size() != input.pieces.size())
-        throw Error(ErrorCode::Usage, "preview: " + std::to_string(input.pieceNames.size()) + " piece names for " +
-                                          std::to_string(input.pieces.size()) + " pieces");
+        throw Error(ErrorCode::Usage, "preview: " + std::to_string(input.pieceNames.size()) +
+                                          " piece names for " + std::to_string(input.pieces.size()) +
+                                          " pieces");
     if (!input.pieceTransforms.empty() && input.pieceTransforms.size() != input.pieces.size())
         throw Error(ErrorCode::Usage, "preview: " + std::to_string(input.pieceTransforms.size()) +
-                                          " piece transforms for " + std::to_string(input.pieces.size()) + " pieces");
+                                          " piece transforms for " + std::to_string(input.pieces.size()) +
+                                          " pieces");
     if (options.sphereSubdivisions < 0 || options.sphereSubdivisions > 5)
         throw Error(ErrorCode::Usage, "preview: sphere subdivisions must be 0..5");
     GlbScene scene;
@@ -233,7 +239,8 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
         const int group = addGroup("pieces");
         for (size_t i = 0; i < input.pieces.size(); ++i) {
             const std::string name = input.pieceNames.empty() ? "piece-" + pad2(i) : input.pieceNames[i];
-            if (input.pieces[i].triangles.empty()) throw Error(ErrorCode::Usage, "preview: " + name + " is empty");
+            if (input.pieces[i].triangles.empty())
+                throw Error(ErrorCode::Usage, "preview: " + name + " is empty");
             scene.materials.push_back(pieceMaterial(i, name));
             GlbMesh mesh;
             mesh.name = name;
@@ -252,19 +259,21 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
         }
     }
 
-    nlohmann::json extras = {{"format", "zomefab.preview"},
-                             {"version", 1},
-                             {"length_unit", "mm"},
-                             {"up_axis", "z"},
-                             {"root_node", "zomefab: rotation -90 deg about x (z up to glTF y up), scale 0.001 (mm to m)"},
-                             {"pieces", pieceNames}};
+    nlohmann::json extras = {
+        {"format", "zomefab.preview"},
+        {"version", 1},
+        {"length_unit", "mm"},
+        {"up_axis", "z"},
+        {"root_node", "zomefab: rotation -90 deg about x (z up to glTF y up), scale 0.001 (mm to m)"},
+        {"pieces", pieceNames}};
     if (input.frame) {
         const zome::Structure& frame = *input.frame;
         const zome::ZomeScale& scale = frame.scale();
         scene.materials.push_back(material("ball", 0.93, 0.93, 0.90, 0.35));
         const int ballMaterial = int(scene.materials.size() - 1);
         // Zometool's colours, sRGB.
-        const std::array<std::array<double, 3>, 3> strutRgb = {{{0.05, 0.33, 0.75}, {1.0, 0.80, 0.05}, {0.85, 0.10, 0.10}}};
+        const std::array<std::array<double, 3>, 3> strutRgb = {
+            {{0.05, 0.33, 0.75}, {1.0, 0.80, 0.05}, {0.85, 0.10, 0.10}}};
         std::array<int, zome::kColorCount> strutMaterial{-1, -1, -1};  // created on first use
 
         const std::vector<zome::BallId> balls = frame.ballIds();
@@ -297,16 +306,17 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
                     // Ball surface to ball surface, as the collision proxy (zome/structure.h).
                     const double lengthMm = scale.strutLengthMm(s.color, s.size) - scale.ballDiameterMm;
                     if (!(lengthMm > 0.0))
-                        throw Error(ErrorCode::Usage, "preview: the ball (" + std::to_string(scale.ballDiameterMm) +
-                                                          " mm) is wider than a " + zome::partName(s.color, s.size) +
-                                                          " strut is long");
+                        throw Error(ErrorCode::Usage, "preview: the ball (" +
+                                                          std::to_string(scale.ballDiameterMm) +
+                                                          " mm) is wider than a " +
+                                                          zome::partName(s.color, s.size) + " strut is long");
                     GlbMesh prismMeshValue = prismMesh("strut-" + zome::partName(s.color, s.size),
                                                        strutCrossSection(s.color), lengthMm);
                     int& colour = strutMaterial[size_t(s.color)];
                     if (colour < 0) {
                         const auto& rgb = strutRgb[size_t(s.color)];
-                        scene.materials.push_back(
-                            material(std::string("strut-") + zome::colorName(s.color), rgb[0], rgb[1], rgb[2]));
+                        scene.materials.push_back(material(std::string("strut-") + zome::colorName(s.color),
+                                                           rgb[0], rgb[1], rgb[2]));
                         colour = int(scene.materials.size() - 1);
                     }
                     prismMeshValue.material = colour;

@@ -30,7 +30,7 @@ struct PreviewInput {
 };
 
 struct PreviewOptions {
-    int sphereSubdivisions = 2;         ///< icosphere levels of the ball mesh: 2 = 320 triangles
+    int sphereSubdivisions = 2;          ///< icosphere levels of the ball mesh: 2 = 320 triangles
     bool isPieceDracoCompressed = true;  ///< KHR_draco_mesh_compression on the pieces
     GlbWriteOptions glb;                 ///< Draco quantisation and speed
     std::string generator;               ///< asset.generator; empty = "zomefab <version>"
@@ -50,7 +50,8 @@ Vec3d strutCrossSectionFrame(int hole);
 
 /// Builds the scene. Node names: "piece-NN" (or pieceNames), "ball-<id>", "strut-<id>" with the
 /// frame's ids; group nodes "zomefab" (root), "pieces", "balls", "struts".
-/// @throw Error(Usage) when pieceNames or pieceTransforms has the wrong size, a piece is empty, or the frame's ball is
+/// @throw Error(Usage) when pieceNames or pieceTransforms has the wrong size, a piece is empty, or the
+/// frame's ball is
 ///   at least as wide as its shortest strut is long.
 GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& options = {});
 

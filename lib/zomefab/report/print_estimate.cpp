@@ -16,7 +16,8 @@ namespace {
 
 void requirePositive(double value, const char* option) {
     if (!(value > 0.0) || !std::isfinite(value))
-        throw Error(ErrorCode::Usage, std::string(option) + " must be a positive number, got " + std::to_string(value));
+        throw Error(ErrorCode::Usage,
+                    std::string(option) + " must be a positive number, got " + std::to_string(value));
 }
 
 }  // namespace
@@ -27,16 +28,19 @@ void PrintSettings::validate() const {
     requirePositive(nozzleMm, "nozzle diameter");
     requirePositive(extrusionWidthMm, "extrusion width");
     if (perimeters < 1) throw Error(ErrorCode::Usage, "perimeters must be at least 1");
-    if (topLayers < 0 || bottomLayers < 0) throw Error(ErrorCode::Usage, "top/bottom layers must not be negative");
+    if (topLayers < 0 || bottomLayers < 0)
+        throw Error(ErrorCode::Usage, "top/bottom layers must not be negative");
     if (!(infillPercent > 0.0 && infillPercent <= 100.0))
-        throw Error(ErrorCode::Usage, "infill must be in (0, 100] percent, got " + std::to_string(infillPercent));
+        throw Error(ErrorCode::Usage,
+                    "infill must be in (0, 100] percent, got " + std::to_string(infillPercent));
 }
 
 void FilamentOptions::validate() const {
     requirePositive(diameterMm, "--filament-mm");
     requirePositive(densityGPerCm3, "--filament-density");
     if (!(usdPerM >= 0.0) || !std::isfinite(usdPerM))
-        throw Error(ErrorCode::Usage, "--filament-usd-per-m must not be negative, got " + std::to_string(usdPerM));
+        throw Error(ErrorCode::Usage,
+                    "--filament-usd-per-m must not be negative, got " + std::to_string(usdPerM));
 }
 
 PrintEstimate& PrintEstimate::operator+=(const PrintEstimate& o) {
@@ -72,12 +76,13 @@ PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const P
     // semicircular ends, so neighbours overlap by h·(1 − π/4)).
     const double spacing = w - h * (1.0 - 0.25 * pi);
     const double wallMm = w + double(s.perimeters - 1) * spacing;  // t_w, horizontal
-    const double topMm = double(s.topLayers) * h;                   // t_s above
+    const double topMm = double(s.topLayers) * h;                  // t_s above
     const double bottomMm =
         s.bottomLayers > 0 ? s.firstLayerHeightMm + double(s.bottomLayers - 1) * h : 0.0;  // t_s below
 
     double perimeterMm3 = 0.0, solidMm3 = 0.0, zMin = 1e300, zMax = -1e300;
-    for (const Vec3f& p : part.positions) zMin = std::min(zMin, double(p[2])), zMax = std::max(zMax, double(p[2]));
+    for (const Vec3f& p : part.positions)
+        zMin = std::min(zMin, double(p[2])), zMax = std::max(zMax, double(p[2]));
     for (const Triangle& t : part.triangles) {
         const Vec3f &a = part.positions[t[0]], &b = part.positions[t[1]], &c = part.positions[t[2]];
         const double ux = double(b[0]) - a[0], uy = double(b[1]) - a[1], uz = double(b[2]) - a[2];
@@ -107,10 +112,13 @@ PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const P
     e.partVolumeMm3 = volume;
     e.perimeterMm3 = perimeterMm3;
     e.solidMm3 = solidMm3;
-    e.infillMm3 = isSolid ? interior : interior * std::min(1.0, 0.01 * s.infillPercent * rates.sparseInfillFactor);
+    e.infillMm3 =
+        isSolid ? interior : interior * std::min(1.0, 0.01 * s.infillPercent * rates.sparseInfillFactor);
     e.filamentMm3 = perimeterMm3 + solidMm3 + e.infillMm3;
     const double height = zMax - zMin;
-    e.layers = height <= s.firstLayerHeightMm ? 1 : 1 + size_t(std::ceil((height - s.firstLayerHeightMm) / h - 1e-9));
+    e.layers = height <= s.firstLayerHeightMm
+                   ? 1
+                   : 1 + size_t(std::ceil((height - s.firstLayerHeightMm) / h - 1e-9));
     e.seconds = e.perimeterMm3 * rates.perimeterSPerMm3 + e.solidMm3 * rates.solidSPerMm3 +
                 e.infillMm3 * (isSolid ? rates.solidInfillSPerMm3 : rates.sparseInfillSPerMm3);
     return e;
@@ -158,10 +166,11 @@ TriMesh orientOnBed(const TriMesh& part, const Vec3d& printerMm) {
     for (int candidate : order) {
         const int k = candidate / 2;
         const double height = size[size_t(k)], u = size[size_t((k + 1) % 3)], v = size[size_t((k + 2) % 3)];
-        const bool fits = height <= printerMm[2] + 1e-6 &&
-                          ((u <= printerMm[0] + 1e-6 && v <= printerMm[1] + 1e-6) ||
-                           (v <= printerMm[0] + 1e-6 && u <= printerMm[1] + 1e-6));
-        if (fits && area[size_t(candidate)] > bestArea * (1.0 + 1e-9)) best = candidate, bestArea = area[size_t(candidate)];
+        const bool fits =
+            height <= printerMm[2] + 1e-6 && ((u <= printerMm[0] + 1e-6 && v <= printerMm[1] + 1e-6) ||
+                                              (v <= printerMm[0] + 1e-6 && u <= printerMm[1] + 1e-6));
+        if (fits && area[size_t(candidate)] > bestArea * (1.0 + 1e-9))
+            best = candidate, bestArea = area[size_t(candidate)];
     }
     TriMesh out = part;
     if (best < 0) best = 4;
@@ -178,7 +187,8 @@ TriMesh orientOnBed(const TriMesh& part, const Vec3d& printerMm) {
     for (Vec3f& p : out.positions) {
         const Vec3f q = p;
         for (int r = 0; r < 3; ++r)
-            p[size_t(r)] = float(rows[best][r][0]) * q[0] + float(rows[best][r][1]) * q[1] + float(rows[best][r][2]) * q[2];
+            p[size_t(r)] = float(rows[best][r][0]) * q[0] + float(rows[best][r][1]) * q[1] +
+                           float(rows[best][r][2]) * q[2];
         zMin = std::min(zMin, p[2]);
     }
     for (Vec3f& p : out.positions) p[2] -= zMin;
@@ -196,8 +206,9 @@ void splitUntilFits(const TriMesh& part, const Box3d& cell, const Vec3d& printer
         return;
     }
     if (depthLeft == 0)
-        throw Error(ErrorCode::Usage, "the baseline cannot cut the object into parts that fit the printer "
-                                      "(octree too deep); is --printer-mm far too small?");
+        throw Error(ErrorCode::Usage,
+                    "the baseline cannot cut the object into parts that fit the printer "
+                    "(octree too deep); is --printer-mm far too small?");
     const Vec3d mid{0.5 * (cell.min[0] + cell.max[0]), 0.5 * (cell.min[1] + cell.max[1]),
                     0.5 * (cell.min[2] + cell.max[2])};
     // Octants in x-major order: x halves, then y halves of each, then z halves.
@@ -220,7 +231,8 @@ void splitUntilFits(const TriMesh& part, const Box3d& cell, const Vec3d& printer
 
 }  // namespace
 
-std::vector<TriMesh> octreeParts(const TriMesh& object, const Vec3d& printerMm, int maxDepth, RunContext& context) {
+std::vector<TriMesh> octreeParts(const TriMesh& object, const Vec3d& printerMm, int maxDepth,
+                                 RunContext& context) {
     for (int i = 0; i < 3; ++i) requirePositive(printerMm[size_t(i)], "--printer-mm");
     std::vector<TriMesh> parts;
     splitUntilFits(object, boundingBox(object), printerMm, maxDepth, parts, context);

@@ -62,9 +62,9 @@ struct PrintEstimate {
     // The model's breakdown (zero when the numbers come from a slicer):
     double partVolumeMm3 = 0.0;
     double perimeterMm3 = 0.0;  ///< perimeter loops
-    double solidMm3 = 0.0;     ///< top/bottom solid layers
-    double infillMm3 = 0.0;    ///< plastic in the interior
-    size_t layers = 0;         ///< summed over parts
+    double solidMm3 = 0.0;      ///< top/bottom solid layers
+    double infillMm3 = 0.0;     ///< plastic in the interior
+    size_t layers = 0;          ///< summed over parts
     size_t parts = 0;
 
     double hours() const { return seconds / 3600.0; }

@@ -83,7 +83,8 @@ bool isSlicerAvailable(const std::string& executable) {
         if (dir.empty()) dir = ".";
         const std::string candidate = dir + "/" + executable;
         struct stat st {};
-        if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(candidate.c_str(), X_OK) == 0)
+        if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
+            ::access(candidate.c_str(), X_OK) == 0)
             return true;
     }
     return false;
@@ -94,22 +95,37 @@ std::vector<std::string> prusaSlicerArguments(const PrintSettings& s, double bed
     // PrusaSlicer refuses the "triangles" pattern at 100 % ("not supposed to work at 100%
     // density"); its solid infill is rectilinear.
     const bool isSolid = s.infillPercent >= 100.0;
-    std::vector<std::string> args = {"--loglevel", "1",
+    std::vector<std::string> args = {"--loglevel",
+                                     "1",
                                      "--export-gcode",
-                                     "--layer-height", formatNumber(s.layerHeightMm),
-                                     "--first-layer-height", formatNumber(s.firstLayerHeightMm),
-                                     "--nozzle-diameter", formatNumber(s.nozzleMm),
-                                     "--filament-diameter", "2.85",
-                                     "--filament-density", "1.24",
-                                     "--fill-density", formatNumber(std::min(100.0, s.infillPercent)) + "%",
-                                     "--fill-pattern", isSolid ? "rectilinear" : "triangles",
-                                     "--perimeters", std::to_string(s.perimeters),
-                                     "--top-solid-layers", std::to_string(s.topLayers),
-                                     "--bottom-solid-layers", std::to_string(s.bottomLayers),
-                                     "--gcode-flavor", "marlin2",
-                                     "--machine-limits-usage", "time_estimate_only",
-                                     "--bed-shape", "0x0," + bed + "x0," + bed + "x" + bed + ",0x" + bed,
-                                     "--max-print-height", bed};
+                                     "--layer-height",
+                                     formatNumber(s.layerHeightMm),
+                                     "--first-layer-height",
+                                     formatNumber(s.firstLayerHeightMm),
+                                     "--nozzle-diameter",
+                                     formatNumber(s.nozzleMm),
+                                     "--filament-diameter",
+                                     "2.85",
+                                     "--filament-density",
+                                     "1.24",
+                                     "--fill-density",
+                                     formatNumber(std::min(100.0, s.infillPercent)) + "%",
+                                     "--fill-pattern",
+                                     isSolid ? "rectilinear" : "triangles",
+                                     "--perimeters",
+                                     std::to_string(s.perimeters),
+                                     "--top-solid-layers",
+                                     std::to_string(s.topLayers),
+                                     "--bottom-solid-layers",
+                                     std::to_string(s.bottomLayers),
+                                     "--gcode-flavor",
+                                     "marlin2",
+                                     "--machine-limits-usage",
+                                     "time_estimate_only",
+                                     "--bed-shape",
+                                     "0x0," + bed + "x0," + bed + "x" + bed + ",0x" + bed,
+                                     "--max-print-height",
+                                     bed};
     // PrusaSlicer's automatic width is 1.125 × nozzle; anything else is passed explicitly.
     if (std::abs(s.extrusionWidthMm - 1.125 * s.nozzleMm) > 1e-9) {
         args.push_back("--extrusion-width");
@@ -131,19 +147,29 @@ double parseSlicerDuration(const std::string& text) {
         const double v = std::strtod(number.c_str(), &end);
         if (end != number.c_str() + number.size() || !(v >= 0.0)) return -1.0;
         switch (unit) {
-            case 'd': seconds += v * 86400.0; break;
-            case 'h': seconds += v * 3600.0; break;
-            case 'm': seconds += v * 60.0; break;
-            case 's': seconds += v; break;
-            default: return -1.0;
+            case 'd':
+                seconds += v * 86400.0;
+                break;
+            case 'h':
+                seconds += v * 3600.0;
+                break;
+            case 'm':
+                seconds += v * 60.0;
+                break;
+            case 's':
+                seconds += v;
+                break;
+            default:
+                return -1.0;
         }
         any = true;
     }
     return any ? seconds : -1.0;
 }
 
-PrintEstimate sliceWithPrusaSlicer(const TriMesh& part, const PrintSettings& settings, const std::string& label,
-                                   const SlicerOptions& options, RunContext& context) {
+PrintEstimate sliceWithPrusaSlicer(const TriMesh& part, const PrintSettings& settings,
+                                   const std::string& label, const SlicerOptions& options,
+                                   RunContext& context) {
     settings.validate();
     if (!isSlicerAvailable(options.executable))
         throw Error(ErrorCode::ProcessingFailed,
@@ -154,10 +180,12 @@ PrintEstimate sliceWithPrusaSlicer(const TriMesh& part, const PrintSettings& set
     const fs::path parent = options.tempDir.empty() ? fs::temp_directory_path(ec) : fs::path(options.tempDir);
     std::string pattern = (parent / "zomefab-slice-XXXXXX").string();
     if (!::mkdtemp(pattern.data()))
-        throw Error(ErrorCode::WriteFailed, std::string("cannot create a scratch directory: ") + std::strerror(errno),
+        throw Error(ErrorCode::WriteFailed,
+                    std::string("cannot create a scratch directory: ") + std::strerror(errno),
                     parent.string());
     ScratchDir scratch{fs::path(pattern)};
-    const fs::path stl = scratch.path / "part.stl", gcode = scratch.path / "part.gcode", log = scratch.path / "slicer.log";
+    const fs::path stl = scratch.path / "part.stl", gcode = scratch.path / "part.gcode",
+                   log = scratch.path / "slicer.log";
     writeMesh(part, stl.string());
 
     const Box3d box = boundingBox(part);
@@ -187,7 +215,8 @@ PrintEstimate sliceWithPrusaSlicer(const TriMesh& part, const PrintSettings& set
         const pid_t r = ::waitpid(pid, &status, WNOHANG);
         if (r == pid) break;
         if (r < 0 && errno != EINTR)
-            throw Error(ErrorCode::ProcessingFailed, "lost the slicer process: " + std::string(std::strerror(errno)));
+            throw Error(ErrorCode::ProcessingFailed,
+                        "lost the slicer process: " + std::string(std::strerror(errno)));
         if (context.isCancelled()) {
             ::kill(pid, SIGTERM);
             ::waitpid(pid, &status, 0);

@@ -31,8 +31,9 @@ std::vector<std::string> prusaSlicerArguments(const PrintSettings& settings, dou
 /// @p context for cancellation while the slicer runs (the child is then killed).
 /// @throw Error(ProcessingFailed) when the slicer is missing, fails (with its last message) or
 ///   prints no estimate; Error(Cancelled); Error(WriteFailed) when the scratch files cannot be written.
-PrintEstimate sliceWithPrusaSlicer(const TriMesh& part, const PrintSettings& settings, const std::string& label,
-                                   const SlicerOptions& options = {}, RunContext& context = RunContext::silent());
+PrintEstimate sliceWithPrusaSlicer(const TriMesh& part, const PrintSettings& settings,
+                                   const std::string& label, const SlicerOptions& options = {},
+                                   RunContext& context = RunContext::silent());
 
 /// Seconds from PrusaSlicer's time format ("1d 2h 3m 4s", "3m 4s", "59s"); negative when malformed.
 double parseSlicerDuration(const std::string& text);

@@ -1,0 +1,159 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// zf-pieces end to end: the files it writes, the same bytes whatever the thread count, and the real
+// checkers on them: admesh (every STL loads without errors or repairs) and PrusaSlicer (a piece
+// slices, the 3MF loads with every part manifold), each run when it is installed.
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <regex>
+
+#include "pieces_fixtures.h"
+#include "test_util.h"
+#include "zomefab/io/mesh_io.h"
+#include "zomefab/mesh/mesh_check.h"
+
+using namespace zomefab;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+int run(const std::string& command) {
+    const int status = std::system(("bash -o pipefail -c " + quoted(command)).c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+bool isInstalled(const std::string& program) { return run("command -v " + program + " > /dev/null") == 0; }
+
+/// The inputs and one zf-pieces run, shared by the cases (the run takes a few seconds).
+struct Run {
+    test::ScratchDir dir{"zomefab-pieces-tools"};
+    int exitCode = -1;
+    Run() {
+        pieces::test::writeToolInputs(dir.path().string());
+        exitCode = run(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " + dir.file("frame.json") + " " +
+                       dir.file("partition.json") + " -q --threads 2 -o " + dir.file("out") + " --report " +
+                       dir.file("report.json"));
+    }
+    std::string out(const std::string& name) const { return dir.file("out/" + name); }
+};
+
+const Run& shared() {
+    static const Run r;
+    return r;
+}
+
+/// The value of "Label : value" in admesh's report.
+std::string admeshField(const std::string& report, const std::string& label) {
+    std::smatch m;
+    if (std::regex_search(report, m, std::regex(label + R"(\s*:\s*([^\n]*))"))) return m[1];
+    return "(missing)";
+}
+
+}  // namespace
+
+TEST_CASE("zf-pieces: one closed STL per piece, pieces.3mf and pieces.json") {
+    const Run& r = shared();
+    REQUIRE(r.exitCode == 0);
+    const nlohmann::json j = nlohmann::json::parse(slurp(r.out("pieces.json")));
+    CHECK(j["format"] == "zomefab.pieces");
+    REQUIRE(j["pieces"].size() == 4);
+    size_t tenons = 0;
+    for (const nlohmann::json& p : j["pieces"]) {
+        const std::string file = p["file"];
+        INFO(file);
+        const TriMesh m = readMesh(r.out(file));
+        const mesh::MeshReport report = mesh::checkMesh(m);
+        CHECK(report.boundaryEdges == 0);
+        CHECK(report.nonManifoldEdges == 0);
+        CHECK(report.volume == doctest::Approx(p["volume_mm3"].get<double>()).epsilon(1e-4));
+        for (int a = 0; a < 3; ++a) CHECK(report.bounds.max[size_t(a)] <= 200.001);
+        CHECK(p["bbox_mm"]["min"][2].get<double>() == doctest::Approx(0).epsilon(1e-4));
+        CHECK(p["neighbors"].size() == 2);
+        tenons += p["tenons"].size();
+        for (const nlohmann::json& t : p["tenons"]) {
+            CHECK(t["ball"].is_number_unsigned());
+            const int hole = t["hole"];
+            CHECK((hole == 0 || hole == 1 || hole == 2 || hole == 15 || hole == 16 || hole == 17));
+        }
+    }
+    CHECK(tenons >= 4);
+    CHECK(slurp(r.out("pieces.3mf")).substr(0, 2) == "PK");
+    const nlohmann::json report = nlohmann::json::parse(slurp(r.dir.file("report.json")));
+    CHECK(report["pieces"] == 4);
+    CHECK(report["tool"] == "zf-pieces");
+}
+
+TEST_CASE("zf-pieces: the same bytes with 1 and 2 threads") {
+    const Run& r = shared();
+    REQUIRE(r.exitCode == 0);
+    const std::string other = r.dir.file("one-thread");
+    REQUIRE(run(test::toolPath("zf-pieces") + " " + r.dir.file("shell.vdb") + " " + r.dir.file("frame.json") + " " +
+                r.dir.file("partition.json") + " -q --threads 1 -o " + other) == 0);
+    size_t files = 0;
+    for (const auto& e : fs::directory_iterator(r.dir.file("out"))) {
+        ++files;
+        INFO(e.path().filename().string());
+        CHECK(slurp(e.path().string()) == slurp(other + "/" + e.path().filename().string()));
+    }
+    CHECK(files == 6);  // 4 STL, 3MF, JSON
+}
+
+TEST_CASE("zf-pieces: admesh loads every piece with no errors and nothing to repair") {
+    if (!isInstalled("admesh")) {
+        MESSAGE("admesh is not installed (apt-get install admesh): skipped");
+        return;
+    }
+    const Run& r = shared();
+    REQUIRE(r.exitCode == 0);
+    for (int i = 0; i < 4; ++i) {
+        const std::string file = r.out("piece-0" + std::to_string(i) + ".stl");
+        const std::string log = r.dir.file("admesh.txt");
+        REQUIRE(run("admesh " + file + " > " + log + " 2>&1") == 0);
+        const std::string report = slurp(log);
+        INFO(file << "\n" << report);
+        CHECK(admeshField(report, "Total disconnected facets") == "0                   0");
+        for (const char* field : {"Degenerate facets", "Edges fixed", "Facets removed", "Facets added", "Facets reversed",
+                                  "Backwards edges", "Normals fixed"})
+            CHECK(admeshField(report, field) == "0");
+        CHECK(report.find("Binary STL file") != std::string::npos);
+    }
+}
+
+TEST_CASE("zf-pieces: PrusaSlicer slices a piece and loads the 3MF") {
+    if (!isInstalled("prusa-slicer")) {
+        MESSAGE("prusa-slicer is not installed (apt-get install --no-install-recommends prusa-slicer): skipped");
+        return;
+    }
+    const Run& r = shared();
+    REQUIRE(r.exitCode == 0);
+    // The printer's own 200 mm bed: PrusaSlicer refuses parts that do not fit it
+    // (../shared/docs/print-estimates.md). Coarse layers keep this quick.
+    const std::string gcode = r.dir.file("piece.gcode");
+    const int code = run("prusa-slicer --loglevel 1 --export-gcode --layer-height 0.3 --first-layer-height 0.3 "
+                         "--nozzle-diameter 0.4 --filament-diameter 2.85 --fill-density 10% --perimeters 2 "
+                         "--gcode-flavor marlin2 --bed-shape 0x0,200x0,200x200,0x200 --max-print-height 200 -o " +
+                         gcode + " " + r.out("piece-00.stl") + " > " + r.dir.file("slicer.txt") + " 2>&1");
+    INFO(slurp(r.dir.file("slicer.txt")));
+    CHECK(code == 0);
+    CHECK(slurp(gcode).find("; estimated printing time") != std::string::npos);
+
+    REQUIRE(run("prusa-slicer --loglevel 1 --info " + r.out("pieces.3mf") + " > " + r.dir.file("info.txt") + " 2>&1") == 0);
+    const std::string info = slurp(r.dir.file("info.txt"));
+    INFO(info);
+    size_t manifold = 0;
+    for (size_t at = info.find("manifold = yes"); at != std::string::npos; at = info.find("manifold = yes", at + 1))
+        ++manifold;
+    CHECK(manifold == 4);
+    CHECK(info.find("manifold = no") == std::string::npos);
+}
