@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "common/cli.h"
+#include "common/scale_options.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/version.h"
 #include "zomefab/io/mesh_io.h"
@@ -52,19 +53,13 @@ int main(int argc, char** argv) {
     cli::Tool tool("zf-info",
                    "Check meshes as the pipeline's first stage does and print a JSON report for each.");
     std::vector<std::string> inputs;
-    std::string inFormat, up = "z";
-    mesh::ScaleOptions scaleOptions;
+    std::string inFormat;
+    cli::ScaleCli scaleCli;
     bool allowInvalid = false;
     mesh::ValidateOptions validateOptions;
     auto& app = tool.app();
     app.add_option("meshes", inputs, "Mesh files (.stl .obj .ply .gltf .glb); - reads stdin")->required();
-    auto* height = app.add_option("--height-mm", scaleOptions.heightMm,
-                                  "Scale uniformly to this height along the up axis");
-    app.add_option("--scale", scaleOptions.scale, "Alternative: multiply file units by this to get mm")
-        ->excludes(height);
-    app.add_option("--up", up, "The input's up axis; y-up meshes are rotated to z up")
-        ->check(CLI::IsMember({"z", "y"}, CLI::ignore_case))
-        ->default_val("z");
+    scaleCli.addTo(app);
     tool.addFormatOption("--in-format", inFormat, {"stl", "obj", "ply", "gltf", "glb"},
                          "Input format (needed for -)");
     app.add_flag("--repair", validateOptions.repair, "Fill holes of up to 300 edges (minimum-area patches)");
@@ -72,8 +67,7 @@ int main(int argc, char** argv) {
                  "Report meshes that fail validation (\"valid\": false and the error) instead of failing");
 
     return tool.run(argc, argv, [&](json& report) {
-        scaleOptions.up = (up == "y" || up == "Y") ? mesh::UpAxis::Y : mesh::UpAxis::Z;
-        mesh::checkScaleOptions(scaleOptions);  // bad options fail before any input is read
+        const mesh::ScaleOptions scaleOptions = scaleCli.resolve();  // bad options fail before any input is read
         MeshReadOptions readOptions;
         if (!inFormat.empty()) readOptions.format = meshFormatFromName(inFormat);
         report = {{"format", "zomefab.info"},

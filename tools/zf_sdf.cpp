@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "common/cli.h"
+#include "common/scale_options.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/version.h"
 #include "zomefab/io/file_io.h"
@@ -20,19 +21,13 @@ using nlohmann::json;
 int main(int argc, char** argv) {
     cli::Tool tool("zf-sdf",
                    "Turn a closed mesh into signed distance level sets (OpenVDB .vdb, millimetres).");
-    std::string input, output, inFormat, up = "z";
-    mesh::ScaleOptions scaleOptions;
+    std::string input, output, inFormat;
+    cli::ScaleCli scaleCli;
     sdf::ObjectFieldOptions options;
     auto& app = tool.app();
     app.add_option("mesh", input, "Closed mesh (.stl .obj .ply .gltf .glb); - reads stdin")->required();
     app.add_option("-o,--output", output, "Output .vdb; - writes stdout")->required();
-    auto* height = app.add_option("--height-mm", scaleOptions.heightMm,
-                                  "Scale uniformly to this height along the up axis");
-    app.add_option("--scale", scaleOptions.scale, "Alternative: multiply file units by this to get mm")
-        ->excludes(height);
-    app.add_option("--up", up, "The input's up axis; y-up meshes are rotated to z up")
-        ->check(CLI::IsMember({"z", "y"}, CLI::ignore_case))
-        ->default_val("z");
+    scaleCli.addTo(app);
     tool.addFormatOption("--in-format", inFormat, {"stl", "obj", "ply", "gltf", "glb"},
                          "Input format (needed for -)");
     app.add_option("--voxel-mm", options.voxelMm, "Voxel size of the object grid")->capture_default_str();
@@ -44,8 +39,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
 
     return tool.run(argc, argv, [&](json& report) {
-        scaleOptions.up = (up == "y" || up == "Y") ? mesh::UpAxis::Y : mesh::UpAxis::Z;
-        mesh::checkScaleOptions(scaleOptions);  // bad options fail before any input is read
+        const mesh::ScaleOptions scaleOptions = scaleCli.resolve();  // bad options fail before any input is read
         sdf::checkObjectFieldOptions(options);
         MeshReadOptions readOptions;
         if (!inFormat.empty()) readOptions.format = meshFormatFromName(inFormat);

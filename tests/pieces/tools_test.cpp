@@ -157,3 +157,38 @@ TEST_CASE("zf-pieces: PrusaSlicer slices a piece and loads the 3MF") {
     CHECK(manifold == 4);
     CHECK(info.find("manifold = no") == std::string::npos);
 }
+
+TEST_CASE("zf-pieces: the real chain zf-sdf, zf-shell, zf-frame, zf-partition, zf-pieces on the bunny") {
+    for (const char* tool : {"zf-sdf", "zf-shell", "zf-frame", "zf-partition"})
+        if (!fs::exists(test::toolPath(tool))) {
+            MESSAGE(tool << " is not built: skipped");
+            return;
+        }
+    test::ScratchDir dir("zomefab-pieces-chain");
+    const std::string bunny = test::dataPath("bunny_npm_3674.stl");
+    REQUIRE(run(test::toolPath("zf-sdf") + " " + bunny + " --height-mm 250 --up y --shell-depth-mm 10 -q -o " +
+                dir.file("bunny.vdb")) == 0);
+    REQUIRE(run(test::toolPath("zf-shell") + " " + dir.file("bunny.vdb") + " --shell-mm 10 -q -o " + dir.file("shell.vdb")) == 0);
+    REQUIRE(run(test::toolPath("zf-frame") + " " + dir.file("bunny.vdb") + " --d-min-mm 10 -q -o " + dir.file("frame.json")) == 0);
+    REQUIRE(run(test::toolPath("zf-partition") + " " + bunny + " " + dir.file("frame.json") + " -q -o " +
+                dir.file("partition.json")) == 0);
+    REQUIRE(run(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " + dir.file("frame.json") + " " +
+                dir.file("partition.json") + " -q -o " + dir.file("out")) == 0);
+    const nlohmann::json j = nlohmann::json::parse(slurp(dir.file("out/pieces.json")));
+    const nlohmann::json partition = nlohmann::json::parse(slurp(dir.file("partition.json")));
+    REQUIRE(j["pieces"].size() >= 2);
+    CHECK(j["pieces"].size() <= partition["pieces"].size());
+    double volume = 0;
+    for (const nlohmann::json& p : j["pieces"]) {
+        const TriMesh m = readMesh(dir.file("out/" + p["file"].get<std::string>()));
+        const mesh::MeshReport report = mesh::checkMesh(m);
+        CHECK(report.boundaryEdges == 0);
+        CHECK(report.nonManifoldEdges == 0);
+        CHECK(report.volume > 0);
+        for (int a = 0; a < 3; ++a) CHECK(report.bounds.max[size_t(a)] <= 200.001);
+        volume += report.volume;
+    }
+    // Tenons add and numbers remove a little: the union stays within 2 % of the shell's voxels.
+    CHECK(volume == doctest::Approx(j["summary"]["shell_volume_mm3"].get<double>()).epsilon(0.02));
+    CHECK(j["summary"]["tenons"].get<int>() >= 1);
+}

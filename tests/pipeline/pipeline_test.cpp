@@ -22,7 +22,7 @@ pipeline::RunOptions smallRunOptions() {
     pipeline::RunOptions o;
     o.scale.heightMm = 250;
     o.scale.up = mesh::UpAxis::Y;
-    o.field.voxelMm = 2.0;
+    o.field.voxelMm = 1.5;  // coarse for speed, fine enough for the tenon pegs (≤ 1.54 mm)
     o.frame.anneal.maxIterations = 20000;
     o.frame.chains = 2;
     o.frame.seed = 7;

@@ -9,22 +9,6 @@
 
 namespace zomefab::cli {
 
-void ScaleCli::addTo(CLI::App& app) {
-    auto* height = app.add_option("--height-mm", options.heightMm,
-                                  "Scale uniformly so the extent along the up axis is this many mm");
-    app.add_option("--scale", options.scale, "Alternative: multiply file units by this to get mm")->excludes(height);
-    app.add_option("--up", up, "The input's up axis; y-up meshes are rotated to z up")
-        ->check(CLI::IsMember({"z", "y"}, CLI::ignore_case))
-        ->default_val("z");
-}
-
-mesh::ScaleOptions ScaleCli::resolve() const {
-    mesh::ScaleOptions resolved = options;
-    resolved.up = (up == "y" || up == "Y") ? mesh::UpAxis::Y : mesh::UpAxis::Z;
-    mesh::checkScaleOptions(resolved);
-    return resolved;
-}
-
 Vec3d parsePrinterMm(const std::string& text) {
     Vec3d v{};
     char s1 = 0, s2 = 0, rest = 0;

@@ -8,20 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "zomefab/mesh/scale.h"
+#include "scale_options.h"
 #include "zomefab/partition/partition.h"
 
 namespace zomefab::cli {
-
-/// --height-mm / --scale / --up, as every tool that reads a mesh in file units takes them.
-struct ScaleCli {
-    mesh::ScaleOptions options;
-    std::string up = "z";
-
-    void addTo(CLI::App& app);
-    /// The options with --up applied. @throw Error(Usage) for a bad height or scale.
-    mesh::ScaleOptions resolve() const;
-};
 
 /// "200x200x200" or "200,200,200" (mm). @throw Error(Usage) naming --printer-mm
 Vec3d parsePrinterMm(const std::string& text);

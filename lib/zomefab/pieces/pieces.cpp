@@ -181,6 +181,10 @@ VoxelField buildField(const FloatGrid& shell) {
     std::vector<const openvdb::BoolTree::LeafNodeType*> leaves;
     for (auto it = region.cbeginLeaf(); it; ++it) leaves.push_back(it.getLeaf());
     const size_t n = leaves.size();
+    // Slots are numbered with 32-bit ids (union-find); 8 million leaves is a 4 m shell at 1 mm.
+    if (n >= (size_t(1) << 32) / kLeafSize - 1)
+        throw Error(ErrorCode::Usage, "the shell has too many voxels (" + std::to_string(n) +
+                                          " leaf nodes) for the pieces stage: use a coarser voxel");
     f.leafOrigin.resize(n);
     f.leafIndex.reserve(n * 2);
     for (size_t i = 0; i < n; ++i) {
@@ -450,6 +454,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
         if (ca != cb) ++contacts[{std::min(ca, cb), std::max(ca, cb)}];
     });
     context.progress("pieces", 0.15);
+    context.debug(std::string("voxels, cells and components: ") + number(clock.seconds(), 3) + " s");
     context.throwIfCancelled();
 
     // --- 2. components → pieces -------------------------------------------------------------
@@ -634,21 +639,24 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
     }
     for (size_t s = 0; s < slotCount; ++s)
         if (field.isInside(s)) field.owner[s] = pieceOfComp[field.owner[s]];
-    for (int layer = 0; layer < sdf::kHalfWidthVoxels; ++layer) {
-        std::vector<std::pair<size_t, uint32_t>> grown;
-        std::unordered_map<size_t, uint32_t> proposal;
-        auto offer = [&](size_t from, size_t to) {
-            if (!field.isActive[to] || field.owner[from] == kNone || field.owner[to] != kNone ||
-                field.cell[from] != field.cell[to])
-                return;
-            auto [it, isNew] = proposal.emplace(to, field.owner[from]);
-            if (!isNew) it->second = std::min(it->second, field.owner[from]);
-        };
-        forEachForwardPair(field, [&](size_t a, size_t b) {
-            offer(a, b);
-            offer(b, a);
-        });
-        for (const auto& [slot, piece] : proposal) field.owner[slot] = piece;
+    {
+        std::vector<uint32_t> proposal(slotCount, kNone);
+        std::vector<size_t> touched;
+        for (int layer = 0; layer < sdf::kHalfWidthVoxels; ++layer) {
+            auto offer = [&](size_t from, size_t to) {
+                if (!field.isActive[to] || field.owner[from] == kNone || field.owner[to] != kNone ||
+                    field.cell[from] != field.cell[to])
+                    return;
+                if (proposal[to] == kNone) touched.push_back(to);
+                proposal[to] = std::min(proposal[to], field.owner[from]);
+            };
+            forEachForwardPair(field, [&](size_t a, size_t b) {
+                offer(a, b);
+                offer(b, a);
+            });
+            for (size_t slot : touched) field.owner[slot] = proposal[slot], proposal[slot] = kNone;
+            touched.clear();
+        }
     }
     for (size_t s = 0; s < slotCount; ++s)
         if (field.isActive[s] && field.owner[s] == kNone) field.owner[s] = cellDefault[field.cell[s]];
@@ -673,6 +681,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
     context.info(std::to_string(pieceCount) + " pieces from " + std::to_string(comps.size()) + " components of " +
                  std::to_string(cellCount) + " cells (" + std::to_string(out.sliversMerged) + " slivers merged)");
     context.progress("pieces", 0.25);
+    context.debug(std::string("pieces: ") + number(clock.seconds(), 3) + " s");
     context.throwIfCancelled();
 
     // --- 3. tenons and labels, planned against the shell and the piece labels ------------------------
@@ -727,6 +736,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
                          " pieces have no engraved number (no flat inner spot clear of cuts and tenons)");
     }
     context.progress("pieces", 0.35);
+    context.debug(std::string("tenons and labels planned: ") + number(clock.seconds(), 3) + " s");
     context.throwIfCancelled();
 
     // --- 4. per piece: level set by CSG, mesh, checks, orientation --------------------------------
@@ -836,6 +846,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
     });
     context.throwIfCancelled();
     context.progress("pieces", 0.5);
+    context.debug(std::string("level sets: ") + number(clock.seconds(), 3) + " s");
     field = VoxelField();
 
     // Meshing. Not OpenVDB's fracture scheme (VolumeToMesh::setRefGrid): it snaps the seam
@@ -855,6 +866,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
         }
     });
     context.throwIfCancelled();
+    context.debug("meshed: " + number(clock.seconds(), 3) + " s");
 
     tbb::parallel_for(tbb::blocked_range<size_t>(0, pieceCount, 1), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t p = range.begin(); p < range.end(); ++p) {
@@ -904,6 +916,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
     });
     context.throwIfCancelled();
     out.seconds = clock.seconds();
+    context.debug("meshed, checked and oriented: " + number(out.seconds, 3) + " s");
     return out;
 }
 
