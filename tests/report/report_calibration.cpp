@@ -131,6 +131,7 @@ int main(int argc, char** argv) {
         {"shell piece R 80 mm, 16 mm wall", test::shellPiece(80, 16)},
         {"shell piece R 120 mm, 16 mm wall", test::shellPiece(120, 16)},
         {"shell piece R 60 mm, 4 mm wall", test::shellPiece(60, 4)},
+        {"dome piece R 100 mm, 16 mm wall", test::domePiece(100, 16, 50)},
         {"bunny 100 mm", test::bunnyMm(100)},
         {"bunny 150 mm", test::bunnyMm(150)},
     };

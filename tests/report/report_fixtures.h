@@ -51,6 +51,14 @@ inline TriMesh shellPiece(double radiusMm, double wallMm, int rings = 48, int se
     return report::clipToBox(sphereShell({0, 0, 0}, radiusMm, wallMm, rings, segments), octant);
 }
 
+/// A flat-lying dome like the pipeline's top pieces: the part of a spherical shell (outer radius
+/// @p radiusMm, wall @p wallMm) above z = @p cutZMm, cut face down on z = 0.
+inline TriMesh domePiece(double radiusMm, double wallMm, double cutZMm) {
+    TriMesh m = report::clipByPlane(sphereShell({0, 0, 0}, radiusMm, wallMm), 2, cutZMm, false);
+    for (Vec3f& p : m.positions) p[2] -= float(cutZMm);
+    return m;
+}
+
 /// data/bunny_npm_3674.stl (y up) turned z up, scaled to @p heightMm, centred in x and y, on z = 0.
 inline TriMesh bunnyMm(double heightMm) {
     TriMesh m = readMesh(dataPath("bunny_npm_3674.stl"));

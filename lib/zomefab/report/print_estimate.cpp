@@ -80,6 +80,9 @@ PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const P
     const double bottomMm =
         s.bottomLayers > 0 ? s.firstLayerHeightMm + double(s.bottomLayers - 1) * h : 0.0;  // t_s below
 
+    // A sloped surface is exposed in a strip h / tan(slope) wide in each layer; PrusaSlicer keeps
+    // (and widens by the margin) only strips at least half an extrusion width wide.
+    const double maxSlopeTan = 2.0 * h / w;
     double perimeterMm3 = 0.0, solidMm3 = 0.0, zMin = 1e300, zMax = -1e300;
     for (const Vec3f& p : part.positions)
         zMin = std::min(zMin, double(p[2])), zMax = std::max(zMax, double(p[2]));
@@ -96,7 +99,8 @@ PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const P
         // Normal-direction thickness of the perimeters (horizontal t_w) and of the solid layers
         // (vertical t_s); where both apply the thicker one wins, the solid layers only add the rest.
         const double wall = wallMm * sinZ;
-        const double skin = (cosZ > 0.0 ? topMm : bottomMm) * std::abs(cosZ);
+        double skin = (cosZ > 0.0 ? topMm : bottomMm) * std::abs(cosZ);
+        if (cosZ != 0.0 && sinZ <= maxSlopeTan * std::abs(cosZ)) skin += rates.skinMarginMm * sinZ;
         perimeterMm3 += area * wall;
         solidMm3 += area * std::max(0.0, skin - wall);
     }

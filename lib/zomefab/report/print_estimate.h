@@ -32,18 +32,23 @@ struct PrintSettings {
 };
 
 /// Rates of the time model and the infill factor: seconds per mm³ of each kind of extrusion.
-/// Defaults: the least-squares fit (relative errors) to PrusaSlicer 2.5.0 over the 28 calibration
+/// Defaults: the least-squares fit (relative errors) to PrusaSlicer 2.5.0 over the 30 calibration
 /// slices of docs/report.md; tests/report/report_calibration.cpp re-runs the fit. A per-layer
 /// term was tried and fitted to zero, and the outer and inner perimeters cannot be told apart by
 /// this model (their volumes are proportional), so each has one rate.
 struct PrintRates {
-    double perimeterSPerMm3 = 0.419;     ///< 2.39 mm³/s: loops at 30 (outer) and 60 mm/s
-    double solidSPerMm3 = 0.498;         ///< 2.01 mm³/s: top/bottom solid layers at 15-20 mm/s
-    double sparseInfillSPerMm3 = 0.151;  ///< 6.6 mm³/s: sparse infill at 80 mm/s
-    double solidInfillSPerMm3 = 0.168;   ///< 6.0 mm³/s: the interior at 100 % (still infill speed)
+    double perimeterSPerMm3 = 0.381;     ///< 2.6 mm³/s: loops at 30 (outer) and 60 mm/s
+    double solidSPerMm3 = 0.553;         ///< 1.8 mm³/s: top/bottom solid layers at 15-20 mm/s
+    double sparseInfillSPerMm3 = 0.146;  ///< 6.8 mm³/s: sparse infill at 80 mm/s
+    double solidInfillSPerMm3 = 0.166;   ///< 6.0 mm³/s: the interior at 100 % (still infill speed)
     /// Plastic in sparse infill per mm³ of interior and per unit of nominal density: PrusaSlicer's
-    /// triangles at 20 % lay down 6.8 % more than 20 % of the interior volume.
-    double sparseInfillFactor = 1.068;
+    /// triangles at 20 % lay down 2.8 % more than 20 % of the interior volume.
+    double sparseInfillFactor = 1.028;
+    /// How far solid layers reach past the exposed part of a sloped surface, horizontally, mm:
+    /// PrusaSlicer widens top and bottom surfaces into the infill to anchor them. Applies to slopes
+    /// whose per-layer exposed strip h / tan(slope) is at least half an extrusion width (41° at
+    /// 0.2 mm layers); fitted to PrusaSlicer's solid-infill volumes (docs/report.md).
+    double skinMarginMm = 1.5;
 };
 
 /// Filament and its price. Default: the paper's 0.56 USD per metre of 2.85 mm PLA (§7.2).
@@ -80,9 +85,10 @@ struct FilamentUse {
 FilamentUse filamentUse(double filamentMm3, const FilamentOptions& filament);
 
 /// Estimates printing the closed, outward part @p part (mm, z up, as it will be printed).
-/// The model (docs/report.md): per facet of area A and unit normal n, the perimeters occupy
-/// A·t_w·sin θ and the top/bottom solid layers A·max(0, t_s·|cos θ| − t_w·sin θ), with
-/// t_w = w + (perimeters − 1)·(w − h(1 − π/4)) and t_s the solid layers' height; both are scaled
+/// The model (docs/report.md): per facet of area A and unit normal n at angle θ to +z, the
+/// perimeters occupy A·t_w·sin θ and the top/bottom solid layers A·max(0, t_s·|cos θ| + m·sin θ −
+/// t_w·sin θ), with t_w = w + (perimeters − 1)·(w − h(1 − π/4)), t_s the solid layers' height and
+/// m = PrintRates::skinMarginMm on shallow slopes (0 on steep ones); both are scaled
 /// down together when they exceed the part's volume (thin parts are solid). The rest of the volume
 /// is infill at the given density. Time = Σ volume·rate. O(F), deterministic.
 PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& settings, const PrintRates& rates = {});
