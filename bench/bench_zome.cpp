@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "zome_fixtures.h"
 #include "zomefab/io/file_io.h"
 #include "zomefab/zome/parts.h"
 #include "zomefab/zome/structure_json.h"
@@ -21,27 +22,11 @@ using namespace zomefab::zome;
 
 namespace {
 
-GoldenVector3 latticePoint(int i, int j, int k) {
-    return {Golden{2 * i, 2 * i}, Golden{2 * j, 2 * j}, Golden{2 * k, 2 * k}};
-}
-
+/// The tests' n×n×n B0 lattice (tests/zome/zome_fixtures.h) with collision cells of @p cellMm.
 Structure makeCubeLattice(int n, double cellMm) {
     CollisionOptions options;
     options.gridCellMm = cellMm;
-    Structure s(ZomeScale{}, options);
-    const int m = n + 1;
-    for (int k = 0; k < m; ++k)
-        for (int j = 0; j < m; ++j)
-            for (int i = 0; i < m; ++i) s.addBall(latticePoint(i, j, k));
-    for (int k = 0; k < m; ++k)
-        for (int j = 0; j < m; ++j)
-            for (int i = 0; i < m; ++i) {
-                const BallId id = BallId(i + m * (j + m * k));
-                if (i < n) s.addStrut(id, 0, 0);
-                if (j < n) s.addStrut(id, 1, 0);
-                if (k < n) s.addStrut(id, 2, 0);
-            }
-    return s;
+    return test::makeCubeLattice(n, ZomeScale{}, options);
 }
 
 /// CPU time of this thread in seconds: less disturbed than wall time when other jobs share the

@@ -2,8 +2,13 @@
 /// @file Shared helpers for the unit tests: data paths, scratch directories, small fixtures.
 #pragma once
 
+#include <doctest/doctest.h>
+
 #include <filesystem>
+#include <functional>
 #include <string>
+
+#include "zomefab/core/error.h"
 
 #include "zomefab/core/tri_mesh.h"
 
@@ -31,6 +36,17 @@ private:
 
 /// Writes @p bytes to @p path (test fixtures only).
 void writeBytes(const std::string& path, const std::string& bytes);
+
+/// The code of the zomefab::Error that @p f throws (a failed check when it throws none).
+inline ErrorCode errorCodeOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        return e.code();
+    }
+    FAIL("no zomefab::Error thrown");
+    return ErrorCode::Internal;
+}
 
 /// An axis-aligned box [min, max] as 12 outward triangles on 8 shared vertices.
 TriMesh makeBox(const Vec3d& min, const Vec3d& max);

@@ -62,7 +62,7 @@ json readJsonFile(const std::string& path) {
 }
 
 struct RunCommand {
-    std::string input, outDir, inFormat, printer = "200x200x200", salientFile;
+    std::string input, outDir, inFormat, printer = "200x200x200", salientFile, slicer = "estimator";
     std::vector<std::string> salientSpheres;
     cli::ScaleCli scale;
     pipeline::RunOptions options;
@@ -88,6 +88,16 @@ struct RunCommand {
         run.add_option("--salient", salientSpheres,
                        "Keep the surface within a sphere whole: x,y,z,r in the scaled object's mm (repeatable)");
         run.add_option("--salient-faces", salientFile, "JSON list of salient face indices of the input mesh");
+        report::CostOptions& cost = options.cost;
+        run.add_option("--slicer", slicer,
+                       "Print times and filament from: estimator (built in) or prusa-slicer (runs it on every part)")
+            ->capture_default_str()
+            ->check(CLI::IsMember({"estimator", "prusa-slicer"}));
+        run.add_option("--filament-mm", cost.filament.diameterMm, "Filament diameter")->capture_default_str();
+        run.add_option("--filament-g-per-cm3", cost.filament.densityGPerCm3, "Filament density")->capture_default_str();
+        run.add_option("--filament-usd-per-m", cost.filament.usdPerM, "Filament price per metre")->capture_default_str();
+        run.add_option("--strut-usd", cost.prices.strutUsd, "Price of one Zometool strut")->capture_default_str();
+        run.add_option("--ball-usd", cost.prices.ballUsd, "Price of one Zometool ball")->capture_default_str();
     }
 
     int execute(cli::Tool& tool, nlohmann::json& report) {
@@ -95,6 +105,7 @@ struct RunCommand {
         options.partition.printerMm = cli::parsePrinterMm(printer);
         for (const std::string& s : salientSpheres) options.partition.salientSpheres.push_back(cli::parseSalientSphere(s));
         options.frame.seed = tool.common().seed;
+        if (slicer == "prusa-slicer") options.cost.source = report::EstimateSource::PrusaSlicer;
         pipeline::checkRunOptions(options);
 
         MeshReadOptions readOptions;
@@ -108,12 +119,8 @@ struct RunCommand {
         report = pipeline::runReportJson(result, options, context);
         const std::vector<std::string> files = pipeline::writeRunOutputs(result, options, report, outDir);
 
-        const zome::PartsList parts = zome::partsList(result.frame.structure);
-        char line[256];
-        std::snprintf(line, sizeof line, "%.0f x %.0f x %.0f mm: %zu balls, %zu struts, %zu pieces; %.1f s",
-                      result.scaled.sizeMm[0], result.scaled.sizeMm[1], result.scaled.sizeMm[2], parts.balls,
-                      parts.strutTotal(), result.pieces.pieces.size(), result.totalSeconds);
-        cli::printInfo(tool, line);
+        for (const std::string& line : pipeline::runSummaryLines(result)) cli::printInfo(tool, line);
+        cli::printInfo(tool, "done in " + std::to_string(int(result.totalSeconds + 0.5)) + " s");
         std::string list;
         for (const std::string& f : files) list += (list.empty() ? "" : ", ") + f;
         cli::printInfo(tool, "wrote " + outDir + ": " + list);

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <string>
 
+#include "glb_test_util.h"
 #include "io_test_util.h"
 #include "test_util.h"
 #include "zomefab/io/file_io.h"
@@ -25,43 +26,6 @@ using namespace zomefab;
 using namespace zomefab::test;
 
 namespace {
-
-/// A parsed GLB: its JSON and its binary chunk.
-struct Glb {
-    nlohmann::json json;
-    std::string bin;
-};
-
-Glb parseGlb(const std::string& bytes) {
-    Glb g;
-    REQUIRE(bytes.size() >= 20);
-    REQUIRE(bytes.compare(0, 4, "glTF") == 0);
-    uint32_t version = 0, length = 0, jsonLength = 0;
-    std::memcpy(&version, bytes.data() + 4, 4);
-    std::memcpy(&length, bytes.data() + 8, 4);
-    std::memcpy(&jsonLength, bytes.data() + 12, 4);
-    CHECK(version == 2);
-    CHECK(length == bytes.size());
-    CHECK(jsonLength % 4 == 0);
-    REQUIRE(bytes.compare(16, 4, "JSON") == 0);
-    g.json = nlohmann::json::parse(bytes.substr(20, jsonLength));
-    const size_t binHeader = 20 + jsonLength;
-    if (binHeader < bytes.size()) {
-        uint32_t binLength = 0;
-        std::memcpy(&binLength, bytes.data() + binHeader, 4);
-        CHECK(bytes.compare(binHeader + 4, 4, std::string("BIN\0", 4)) == 0);
-        CHECK(binLength % 4 == 0);
-        g.bin = bytes.substr(binHeader + 8, binLength);
-        CHECK(binHeader + 8 + binLength == bytes.size());
-    }
-    return g;
-}
-
-std::string viewBytes(const Glb& g, int view) {
-    const nlohmann::json& v = g.json["bufferViews"][size_t(view)];
-    CHECK(v["byteOffset"].get<size_t>() % 4 == 0);
-    return g.bin.substr(v["byteOffset"].get<size_t>(), v["byteLength"].get<size_t>());
-}
 
 /// A sphere (Draco) and a box (plain, with normals, shown by three nodes) under a scaled root.
 GlbScene testScene() {
@@ -113,31 +77,6 @@ GlbScene testScene() {
     s.sceneName = "test";
     s.extras = {{"parts", {{"balls", 3}}}};
     return s;
-}
-
-std::string nodePrefix() {
-    const char* env = std::getenv("ZOMEFAB_NODE_DIR");
-    return env ? env : ZOMEFAB_NODE_DIR;
-}
-
-bool hasCommand(const std::string& name) {
-    return std::system(("command -v " + name + " > /dev/null 2>&1").c_str()) == 0;
-}
-
-/// Runs the Khronos validator on @p path; returns its JSON summary (errors, warnings, messages).
-nlohmann::json khronosValidate(const std::string& path) {
-    const std::string cmd =
-        "node '" + std::string(ZOMEFAB_VALIDATOR_SCRIPT) + "' '" + nodePrefix() + "' '" + path + "' 2>&1";
-    FILE* pipe = ::popen(cmd.c_str(), "r");
-    REQUIRE(pipe != nullptr);
-    std::string out;
-    char buf[4096];
-    while (size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-    const int status = ::pclose(pipe);
-    INFO("validator output: " << out);
-    REQUIRE(WIFEXITED(status));
-    REQUIRE(WEXITSTATUS(status) != 2);  // 2 = validator missing: run `make test-deps`
-    return nlohmann::json::parse(out);
 }
 
 }  // namespace
@@ -315,16 +254,8 @@ TEST_CASE("glb_write: draco_decoder decodes every compressed primitive") {
     ScratchDir dir("zomefab-drc");
     writeBytes(dir.file("sphere.drc"),
                viewBytes(g, prim["extensions"]["KHR_draco_mesh_compression"]["bufferView"]));
-    const std::string cmd = "draco_decoder -i '" + dir.file("sphere.drc") + "' -o '" +
-                            dir.file("sphere.obj") + "' > /dev/null 2>&1";
-    REQUIRE(std::system(cmd.c_str()) == 0);
-    std::ifstream obj(dir.file("sphere.obj"));
-    std::string line;
-    size_t vertices = 0, faces = 0;
-    while (std::getline(obj, line)) {
-        if (line.rfind("v ", 0) == 0) ++vertices;
-        if (line.rfind("f ", 0) == 0) ++faces;
-    }
+    const auto [vertices, faces] = dracoDecodeCounts(dir.file("sphere.drc"), dir.file("sphere.obj"));
+    REQUIRE(vertices > 0);
     CHECK(vertices ==
           g.json["accessors"][prim["attributes"]["POSITION"].get<size_t>()]["count"].get<size_t>());
     CHECK(3 * faces == g.json["accessors"][prim["indices"].get<size_t>()]["count"].get<size_t>());

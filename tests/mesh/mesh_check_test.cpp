@@ -350,3 +350,29 @@ TEST_CASE("validate --repair: a boundary that touches itself is left open") {
         CHECK(contains(e.what(), "bowtie.obj: open mesh: 6 boundary edges"));
     }
 }
+
+TEST_CASE("removeCavities: drops a sealed inner pocket, keeps the solid and separate solids") {
+    TriMesh solid = test::makeBox({0, 0, 0}, {10, 10, 10});
+    TriMesh pocket = test::makeBox({4, 4, 4}, {6, 6, 7});  // 12 mm³, inward: a cavity
+    for (Triangle& t : pocket.triangles) std::swap(t[1], t[2]);
+    TriMesh second = test::makeBox({20, 0, 0}, {22, 2, 2});  // a separate positive solid stays
+    TriMesh m = solid;
+    for (const TriMesh* part : {&pocket, &second}) {
+        const uint32_t base = uint32_t(m.positions.size());
+        m.positions.insert(m.positions.end(), part->positions.begin(), part->positions.end());
+        for (Triangle t : part->triangles) m.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    }
+    REQUIRE(mesh::checkMesh(m).volume == doctest::Approx(1000 - 12 + 8));
+    const mesh::CavityRemoval removal = mesh::removeCavities(m);
+    CHECK(removal.cavities == 1);
+    CHECK(removal.volumeMm3 == doctest::Approx(12));
+    const mesh::MeshReport after = mesh::checkMesh(m);
+    CHECK(after.volume == doctest::Approx(1008));
+    CHECK(after.triangleCount == 24);
+    CHECK(after.vertexCount == 16);
+    CHECK(after.isClosed());
+
+    TriMesh plain = solid;
+    CHECK(mesh::removeCavities(plain).cavities == 0);
+    CHECK(plain.triangles == solid.triangles);
+}

@@ -44,6 +44,21 @@ TEST_CASE("pipeline: the small bunny end to end, outputs consistent with each ot
     const nlohmann::json report = pipeline::runReportJson(result, options, RunContext::silent());
     const auto files = pipeline::writeRunOutputs(result, options, report, out);
     for (const std::string& f : files) CHECK(fs::exists(fs::path(out) / f));
+    CHECK(files == std::vector<std::string>{"assembly.md", "cost.md", "frame.json", "frame.vef", "partition.json",
+                                            "pieces.3mf", "pieces/", "preview.glb", "report.json"});
+    CHECK(!fs::exists(out + "/pieces/pieces.3mf"));  // moved up, next to the preview
+    // The cost report prices exactly the pieces written and the frame's parts.
+    CHECK(report["cost"]["pieces"] == result.pieces.pieces.size());
+    CHECK(report["cost"]["pieces_volume_mm3"].get<double>() ==
+          doctest::Approx(report["pieces"]["volume_mm3"].get<double>()).epsilon(1e-6));
+    CHECK(report["cost"]["zometool"]["balls"] == report["frame"]["balls"]);
+    for (const char* key : {"material_saved_hollow_percent", "time_saved_hollow_percent", "material_saved_solid_percent"})
+        CHECK(report["cost"][key].is_number());
+    CHECK(report["cost"]["source"] == "estimator");
+    const std::string costMd = readInputBytes(out + "/cost.md");
+    CHECK(costMd.find("| hollow (20%) | ZomeFab |") != std::string::npos);
+    CHECK(readInputBytes(out + "/assembly.md").find("## Parts list") != std::string::npos);
+    CHECK(readInputBytes(out + "/preview.glb").substr(0, 4) == "glTF");
     // The frame file reads back to the same parts list the report states.
     const zome::Structure back = zome::structureFromJsonText(readInputBytes(out + "/frame.json"));
     const zome::PartsList parts = zome::partsList(back);

@@ -22,16 +22,6 @@ namespace {
 
 const double kPi = std::acos(-1.0);
 
-ErrorCode codeOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.code();
-    }
-    FAIL("no zomefab::Error thrown");
-    return ErrorCode::Internal;
-}
-
 double radius(const Vec3f& p, const Vec3d& c) {
     return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) +
                      (p[2] - c[2]) * (p[2] - c[2]));
@@ -128,10 +118,10 @@ TEST_CASE("level_set: an inset iso-surface lies that far inside") {
     for (const Vec3f& p : mesh.positions) worst = std::max(worst, std::abs(radius(p, c) - 26.0));
     CHECK(worst < 0.5);
     meshing.isoMm = -20.0;  // beyond the 5 mm band (+ half width)
-    CHECK(codeOf([&] { levelSetToMesh(ls, meshing, RunContext::silent()); }) == ErrorCode::Usage);
+    CHECK(test::errorCodeOf([&] { levelSetToMesh(ls, meshing, RunContext::silent()); }) == ErrorCode::Usage);
     meshing.isoMm = 0;
     meshing.adaptivity = 1.5;
-    CHECK(codeOf([&] { levelSetToMesh(ls, meshing, RunContext::silent()); }) == ErrorCode::Usage);
+    CHECK(test::errorCodeOf([&] { levelSetToMesh(ls, meshing, RunContext::silent()); }) == ErrorCode::Usage);
 }
 
 TEST_CASE("level_set: the whole interior band holds exact depths") {
@@ -164,7 +154,7 @@ TEST_CASE("level_set: open inputs fail instead of giving garbage") {
         scale.heightMm = 120.0;
         scale.up = mesh::UpAxis::Y;
         const TriMesh mesh = mesh::scaleToMillimetres(readMesh(path), scale).mesh;
-        CHECK(codeOf([&] { meshToLevelSet(mesh, {}, RunContext::silent()); }) == ErrorCode::ProcessingFailed);
+        CHECK(test::errorCodeOf([&] { meshToLevelSet(mesh, {}, RunContext::silent()); }) == ErrorCode::ProcessingFailed);
     }
 }
 
@@ -172,25 +162,25 @@ TEST_CASE("level_set: bad options and inputs give the documented error codes") {
     const TriMesh box = test::makeBox({0, 0, 0}, {10, 10, 10});
     MeshToLevelSetOptions options;
     options.voxelMm = 0;
-    CHECK(codeOf([&] { meshToLevelSet(box, options, RunContext::silent()); }) == ErrorCode::Usage);
+    CHECK(test::errorCodeOf([&] { meshToLevelSet(box, options, RunContext::silent()); }) == ErrorCode::Usage);
     options.voxelMm = std::nan("");
-    CHECK(codeOf([&] { meshToLevelSet(box, options, RunContext::silent()); }) == ErrorCode::Usage);
+    CHECK(test::errorCodeOf([&] { meshToLevelSet(box, options, RunContext::silent()); }) == ErrorCode::Usage);
     options.voxelMm = 1e-5;  // would need ~10^14 voxels
-    CHECK(codeOf([&] { meshToLevelSet(box, options, RunContext::silent()); }) == ErrorCode::Usage);
-    CHECK(codeOf([&] { meshToLevelSet(TriMesh{}, {}, RunContext::silent()); }) == ErrorCode::InvalidInput);
+    CHECK(test::errorCodeOf([&] { meshToLevelSet(box, options, RunContext::silent()); }) == ErrorCode::Usage);
+    CHECK(test::errorCodeOf([&] { meshToLevelSet(TriMesh{}, {}, RunContext::silent()); }) == ErrorCode::InvalidInput);
     TriMesh broken = box;
     broken.triangles[3][1] = 99;
-    CHECK(codeOf([&] { meshToLevelSet(broken, {}, RunContext::silent()); }) == ErrorCode::InvalidInput);
+    CHECK(test::errorCodeOf([&] { meshToLevelSet(broken, {}, RunContext::silent()); }) == ErrorCode::InvalidInput);
     broken = box;
     broken.positions[2][0] = std::numeric_limits<float>::infinity();
-    CHECK(codeOf([&] { meshToLevelSet(broken, {}, RunContext::silent()); }) == ErrorCode::InvalidInput);
+    CHECK(test::errorCodeOf([&] { meshToLevelSet(broken, {}, RunContext::silent()); }) == ErrorCode::InvalidInput);
 }
 
 TEST_CASE("level_set: a cancelled context stops the conversion with Cancelled") {
     std::atomic<bool> cancel{true};
     RunContext context({}, {}, &cancel);
     const TriMesh sphere = test::makeSphere({0, 0, 0}, 30.0);
-    CHECK(codeOf([&] { meshToLevelSet(sphere, {}, context); }) == ErrorCode::Cancelled);
+    CHECK(test::errorCodeOf([&] { meshToLevelSet(sphere, {}, context); }) == ErrorCode::Cancelled);
 }
 
 TEST_CASE("level_set: the same input gives the same grid bytes with 1 or 2 threads") {

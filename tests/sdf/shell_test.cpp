@@ -17,16 +17,6 @@ namespace {
 
 const double kPi = std::acos(-1.0);
 
-ErrorCode codeOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.code();
-    }
-    FAIL("no zomefab::Error thrown");
-    return ErrorCode::Internal;
-}
-
 TriMesh bunnyMm(const std::string& file, double heightMm) {
     mesh::ScaleOptions scale;
     scale.heightMm = heightMm;
@@ -125,9 +115,9 @@ TEST_CASE("shell: options outside the allowed range are usage errors") {
     const LevelSet object = meshToLevelSet(sphere, options, RunContext::silent());
     ShellOptions shell;
     shell.shellMm = 0.5;
-    CHECK(codeOf([&] { makeShell(object, shell, RunContext::silent()); }) == ErrorCode::Usage);
+    CHECK(test::errorCodeOf([&] { makeShell(object, shell, RunContext::silent()); }) == ErrorCode::Usage);
     shell.shellMm = 6.0;  // deeper than the 5 mm band
-    CHECK(codeOf([&] { makeShell(object, shell, RunContext::silent()); }) == ErrorCode::Usage);
+    CHECK(test::errorCodeOf([&] { makeShell(object, shell, RunContext::silent()); }) == ErrorCode::Usage);
     shell.shellMm = 5.0;
     CHECK(makeShell(object, shell, RunContext::silent()).activeVoxelCount() > 0);
 }

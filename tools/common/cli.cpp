@@ -79,15 +79,19 @@ int Tool::run(int argc, char** argv, const std::function<int(nlohmann::json&)>& 
     auto stageClock = std::make_shared<Stopwatch>();
     auto lastPrint = std::make_shared<double>(-1.0);
     auto lastStage = std::make_shared<std::string>();
-    auto progress = [toolName, verbosity, stageClock, lastPrint, lastStage](const std::string& stage,
-                                                                            double fraction) {
+    auto lastFraction = std::make_shared<double>(-1.0);
+    auto progress = [toolName, verbosity, stageClock, lastPrint, lastStage, lastFraction](const std::string& stage,
+                                                                                          double fraction) {
         if (verbosity < 0) return;
         const double now = stageClock->seconds();
         const bool isNewStage = stage != *lastStage;
-        // At most two lines a second per stage, plus the start and end of each stage.
+        // At most two lines a second per stage, plus the start and end of each stage (once: a stage
+        // and the pipeline around it may both report its end).
         if (!isNewStage && fraction < 1.0 && now - *lastPrint < 0.5) return;
+        if (!isNewStage && fraction >= 1.0 && *lastFraction >= 1.0) return;
         *lastStage = stage;
         *lastPrint = now;
+        *lastFraction = fraction;
         std::fprintf(stderr, "%s: [%s] %3d%% %.1f s\n", toolName.c_str(), stage.c_str(),
                      int(fraction * 100.0 + 0.5), now);
     };

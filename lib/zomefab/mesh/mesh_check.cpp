@@ -570,4 +570,43 @@ TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const s
     return mesh;
 }
 
+CavityRemoval removeCavities(TriMesh& mesh) {
+    DisjointSets sets(mesh.vertexCount());
+    for (const Triangle& t : mesh.triangles) sets.unite(t[0], t[1]), sets.unite(t[1], t[2]);
+    // Volumes about the bounding-box centre, to keep the sums well conditioned far from the origin.
+    const Box3d box = boundingBox(mesh);
+    const Vec3d centre{(box.min[0] + box.max[0]) / 2, (box.min[1] + box.max[1]) / 2, (box.min[2] + box.max[2]) / 2};
+    std::vector<double> volume(mesh.vertexCount(), 0.0);  // indexed by the component's root vertex
+    for (const Triangle& t : mesh.triangles) {
+        const Vec3d a = sub(toDouble(mesh.positions[t[0]]), centre);
+        const Vec3d b = sub(toDouble(mesh.positions[t[1]]), centre);
+        const Vec3d c = sub(toDouble(mesh.positions[t[2]]), centre);
+        volume[sets.find(t[0])] += dot(a, cross(b, c)) / 6.0;
+    }
+    CavityRemoval removal;
+    for (uint32_t v = 0; v < mesh.vertexCount(); ++v)
+        if (sets.find(v) == v && volume[v] < 0.0) ++removal.cavities, removal.volumeMm3 -= volume[v];
+    if (removal.cavities == 0) return removal;
+
+    TriMesh kept;
+    std::vector<uint32_t> newIndex(mesh.vertexCount(), UINT32_MAX);
+    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+        const Triangle& t = mesh.triangles[i];
+        if (volume[sets.find(t[0])] < 0.0) continue;
+        Triangle out;
+        for (int c = 0; c < 3; ++c) {
+            uint32_t& index = newIndex[t[size_t(c)]];
+            if (index == UINT32_MAX) {
+                index = uint32_t(kept.positions.size());
+                kept.positions.push_back(mesh.positions[t[size_t(c)]]);
+            }
+            out[size_t(c)] = index;
+        }
+        kept.triangles.push_back(out);
+        if (!mesh.salientFaces.empty()) kept.salientFaces.push_back(mesh.salientFaces[i]);
+    }
+    mesh = std::move(kept);
+    return removal;
+}
+
 }  // namespace zomefab::mesh

@@ -38,6 +38,19 @@ struct MeshReport {
 /// @throw Error(InvalidInput) when a triangle refers to a vertex that does not exist.
 MeshReport checkMesh(const TriMesh& mesh);
 
+/// What removeCavities() removed.
+struct CavityRemoval {
+    size_t cavities = 0;     ///< closed components of negative volume
+    double volumeMm3 = 0.0;  ///< their total volume (positive)
+};
+
+/// Drops the vertex-connected components of negative signed volume from a closed, outward mesh:
+/// cavities sealed inside the solid (e.g. a gap a voxel wide left between two unioned level sets),
+/// which a slicer would print as empty pockets and which make admesh count extra parts. The solid
+/// is then full there. Unused vertices are dropped; the other triangles keep their order.
+/// Deterministic, O(F α(V)).
+CavityRemoval removeCavities(TriMesh& mesh);
+
 struct ValidateOptions {
     /// |volume| below this fraction of the bounding-box diagonal cubed counts as zero volume
     /// (a flat or self-cancelling surface); 1e-9 keeps a 100 x 100 x 0.01 mm plate.

@@ -2,6 +2,7 @@
 #include "zomefab/pipeline/pipeline.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 
@@ -34,6 +35,18 @@ auto timedStage(const std::string& name, RunResult& result, RunContext& context,
     return value;
 }
 
+/// "piece-07": the piece's file name without ".stl", as node and guide name.
+std::string pieceName(const pieces::Pieces& all, size_t index) {
+    const std::string file = pieces::pieceFileName(all, index);
+    return file.substr(0, file.size() - 4);
+}
+
+std::string format(const char* pattern, double a, double b = 0, double c = 0, double d = 0) {
+    char text[256];
+    std::snprintf(text, sizeof text, pattern, a, b, c, d);
+    return text;
+}
+
 /// Errors that stages raise about the object itself belong to the input file.
 [[noreturn]] void rethrowAboutInput(const Error& e, const std::string& sourceName) {
     if (e.code() == ErrorCode::Usage || e.code() == ErrorCode::Cancelled || e.code() == ErrorCode::Internal)
@@ -56,6 +69,18 @@ void checkRunOptions(const RunOptions& options) {
     partition::checkPartitionOptions(options.partition, options.frame.lattice.scale);
     pieces::checkPiecesOptions(options.pieces);
     if (options.frame.chains < 1) throw Error(ErrorCode::Usage, "--chains must be at least 1");
+    // The pieces stage would find this out only after the level sets; say it before any work.
+    const double maxVoxelMm = 0.5 * pieces::pegShortMm(options.pieces.tenons);
+    if (options.pieces.tenons.maxPerPiece > 0 && options.field.voxelMm > maxVoxelMm)
+        throw Error(ErrorCode::Usage, "--voxel-mm " + format("%g", options.field.voxelMm) + ": the tenon pegs (" +
+                                          format("%.2f", pieces::pegShortMm(options.pieces.tenons)) +
+                                          " mm thick) need a voxel of at most " + format("%.2f", maxVoxelMm) + " mm");
+    options.cost.print.validate();
+    options.cost.filament.validate();
+    if (options.cost.source == report::EstimateSource::PrusaSlicer &&
+        !report::isSlicerAvailable(options.cost.slicer.executable))
+        throw Error(ErrorCode::Usage, "--slicer " + options.cost.slicer.executable +
+                                          ": not installed or not executable (Debian package prusa-slicer)");
 }
 
 RunResult runPipeline(const TriMesh& input, const std::string& sourceName, const RunOptions& options,
@@ -140,8 +165,66 @@ RunResult runPipeline(const TriMesh& input, const std::string& sourceName, const
                                   piecesOptions, context);
     });
 
+    // Stage 7: what the user reads (paper §7): the assembly guide and the cost report (Table 1).
+    timedStage("report", result, context, [&] {
+        std::vector<report::TenonLink> links;
+        std::vector<std::string> names;
+        std::vector<TriMesh> printed;
+        for (size_t i = 0; i < result.pieces.pieces.size(); ++i) {
+            const pieces::Piece& piece = result.pieces.pieces[i];
+            names.push_back(pieceName(result.pieces, i));
+            for (const pieces::Tenon& tenon : piece.tenons) links.push_back({names.back(), tenon.ball, tenon.hole});
+            printed.push_back(piece.mesh);
+        }
+        result.assembly = report::assemblyGuide(result.frame.structure, links, names);
+        report::CostOptions costOptions = options.cost;
+        costOptions.printerMm = options.partition.printerMm;
+        result.cost = report::costReport(result.scaled.mesh, printed, zome::partsList(result.frame.structure),
+                                         costOptions, context);
+        return 0;
+    });
+
     result.totalSeconds = total.seconds();
     return result;
+}
+
+report::PreviewInput previewInput(const RunResult& result) {
+    report::PreviewInput input;
+    const Transform4d gridToFrameMm = affineInverse(result.pieces.frameToGridMm);
+    for (size_t i = 0; i < result.pieces.pieces.size(); ++i) {
+        const pieces::Piece& piece = result.pieces.pieces[i];
+        input.pieces.push_back(piece.mesh);
+        input.pieceNames.push_back(pieceName(result.pieces, i));
+        input.pieceTransforms.push_back(gridToFrameMm * affineInverse(piece.gridToPrintMm));
+    }
+    input.frame = &result.frame.structure;
+    input.extras = {{"source", result.sourceName}, {"size_mm", result.scaled.sizeMm}};
+    return input;
+}
+
+std::vector<std::string> runSummaryLines(const RunResult& result) {
+    std::vector<std::string> lines;
+    const zome::PartsList& parts = result.cost.parts;
+    size_t tenons = 0, fewTenons = 0;
+    for (const pieces::Piece& piece : result.pieces.pieces) {
+        tenons += piece.tenons.size();
+        fewTenons += !piece.tenonShortfall.empty();
+    }
+    lines.push_back(format("%.0f x %.0f x %.0f mm", result.scaled.sizeMm[0], result.scaled.sizeMm[1],
+                           result.scaled.sizeMm[2]) +
+                    ": frame of " + std::to_string(parts.balls) + " balls and " + std::to_string(parts.strutTotal()) +
+                    " struts (" + std::to_string(result.assembly.layers) + " layers to build), " +
+                    std::to_string(result.pieces.pieces.size()) + " printed pieces with " + std::to_string(tenons) +
+                    " tenons" + (fewTenons ? " (" + std::to_string(fewTenons) + " pieces with fewer than planned)" : ""));
+    for (const report::CostCase& c : result.cost.cases) {
+        lines.push_back(c.name + format(" (%.0f%% infill): ", c.infillPercent) +
+                        format("print %.1f h, %.2f kg, %.2f USD", c.zomefab.print.hours(), c.zomefab.filament.massG / 1000.0,
+                               c.zomefab.filament.costUsd) +
+                        format(" + Zometool %.2f USD, %.1f h to build", c.zomefab.zomeUsd, c.zomefab.assemblyHours) +
+                        format("; whole object %.1f h, %.2f USD", c.baseline.print.hours(), c.baseline.totalUsd()) +
+                        format(": saves %.0f%% time, %.0f%% material", c.savedTimePercent, c.savedMaterialPercent));
+    }
+    return lines;
 }
 
 nlohmann::json runReportJson(const RunResult& result, const RunOptions& options, const RunContext& context) {
@@ -187,6 +270,17 @@ nlohmann::json runReportJson(const RunResult& result, const RunOptions& options,
                         {"volume_mm3", piecesVolumeMm3},
                         {"shell_volume_mm3", result.pieces.shellVolumeMm3},
                         {"slivers_merged", result.pieces.sliversMerged}};
+    report["assembly"] = {{"layers", result.assembly.layers},
+                          {"components", result.assembly.components},
+                          {"file", "assembly.md"}};
+    nlohmann::json cost = report::costReportToJson(result.cost);
+    // The headline numbers (paper Table 1's "Efficiency (Saved)" columns), flat for batch summaries.
+    for (const report::CostCase& c : result.cost.cases) {
+        cost["time_saved_" + c.name + "_percent"] = c.savedTimePercent;
+        cost["material_saved_" + c.name + "_percent"] = c.savedMaterialPercent;
+        cost["filament_saved_" + c.name + "_percent"] = c.savedFilamentPercent;
+    }
+    report["cost"] = cost;
     nlohmann::json timings = nlohmann::json::array();
     for (const StageTiming& t : result.timings) timings.push_back({{"stage", t.stage}, {"seconds", t.seconds}});
     report["timings"] = timings;
@@ -217,6 +311,21 @@ std::vector<std::string> writeRunOutputs(const RunResult& result, const RunOptio
     });
     pieces::writePieces(result.pieces, staged.file("pieces"), {result.sourceName, "frame.json", "partition.json"});
     written.push_back("pieces/");
+    // The 3MF holds every piece: one file to open in a slicer, next to the preview, not among the STLs.
+    std::error_code ec;
+    std::filesystem::rename(staged.file("pieces") + "/pieces.3mf", staged.file("pieces.3mf"), ec);
+    if (ec) throw Error(ErrorCode::WriteFailed, "cannot move pieces.3mf: " + ec.message(), outDir);
+    written.push_back("pieces.3mf");
+    report::writePreview(previewInput(result), staged.file("preview.glb"), options.preview);
+    written.push_back("preview.glb");
+    write("assembly.md", [&](std::ostream& out) {
+        out << report::assemblyGuideMarkdown(result.assembly, options.cost.prices);
+    });
+    write("cost.md", [&](std::ostream& out) {
+        out << "# Cost and time: " << std::filesystem::path(result.sourceName).filename().string() << "\n\n";
+        for (const std::string& line : runSummaryLines(result)) out << "- " << line << "\n";
+        out << "\n" << report::costReportMarkdown(result.cost);
+    });
     write(kReportFile, [&](std::ostream& out) { out << report.dump(2) << '\n'; });
     staged.commit();
     std::sort(written.begin(), written.end());

@@ -15,6 +15,9 @@
 #include "zomefab/mesh/scale.h"
 #include "zomefab/partition/partition.h"
 #include "zomefab/pieces/pieces.h"
+#include "zomefab/report/assembly_guide.h"
+#include "zomefab/report/cost_report.h"
+#include "zomefab/report/preview_scene.h"
 #include "zomefab/sdf/level_set.h"
 
 namespace zomefab::pipeline {
@@ -27,6 +30,10 @@ struct RunOptions {
     frame::FrameOptions frame;       ///< chains, seed, annealing budget (paper §4)
     partition::PartitionOptions partition;  ///< printer size, saliency (paper §5)
     pieces::PiecesOptions pieces;    ///< tenons, slivers, meshing; printer size from partition
+    /// Cost and time report (paper §7.2, Table 1): print profile, filament, Zometool prices,
+    /// estimator or PrusaSlicer; its printer size comes from the partition's.
+    report::CostOptions cost;
+    report::PreviewOptions preview;  ///< preview.glb: Draco settings
 };
 
 /// Seconds spent in each stage, in run order.
@@ -48,6 +55,8 @@ struct RunResult {
     TriMesh surfaceFrameMm;            ///< the scaled surface in the frame's coordinates
     partition::PartitionResult partition;
     pieces::Pieces pieces;             ///< printable pieces, in printer coordinates
+    report::AssemblyGuide assembly;    ///< build order of the frame and the pieces' tenons
+    report::CostReport cost;           ///< Table 1: ZomeFab against the octree baseline
     std::vector<StageTiming> timings;
     double totalSeconds = 0;
 };
@@ -61,10 +70,18 @@ void checkRunOptions(const RunOptions& options);
 RunResult runPipeline(const TriMesh& input, const std::string& sourceName, const RunOptions& options,
                       RunContext& context);
 
-/// The run's report.json: input, options, per-stage numbers and timings, warnings.
+/// The preview scene's input for @p result: every piece placed back into the frame's mm, the frame.
+report::PreviewInput previewInput(const RunResult& result);
+
+/// One line per fact a user wants first: size, parts, pieces, print hours and material, savings.
+std::vector<std::string> runSummaryLines(const RunResult& result);
+
+/// The run's report.json: input, options, per-stage numbers and timings, cost, warnings.
 nlohmann::json runReportJson(const RunResult& result, const RunOptions& options, const RunContext& context);
 
-/// Writes every output file of @p result into @p outDir through a staging directory, so a failure
+/// Writes every output file of @p result into @p outDir (frame.json, frame.vef, partition.json,
+/// pieces/ with piece-NN.stl and pieces.json, pieces.3mf, preview.glb, assembly.md, cost.md,
+/// report.json) through a staging directory, so a failure
 /// leaves no half-written directory (an existing output directory of zomefab is replaced; any
 /// other existing non-empty directory is refused). Returns the file names written, sorted.
 /// @throw Error(WriteFailed)
