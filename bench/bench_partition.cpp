@@ -8,7 +8,7 @@
 ///
 ///   bench_partition [bunny|million|compare|compare-million|all] [--compare-graph-nodes G]
 ///                   [--compare-refine-nodes R] [--compare-w-smoothness W] [--threads N] [--k K] [--svm-cost C] [--svm-eps E]
-///                   [--svm-max-samples N] [--graph-nodes N] [--refine-nodes N]
+///                   [--svm-max-samples N] [--graph-nodes N] [--refine-nodes N] [--whole-surface-schedule]
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -42,9 +42,10 @@ void report(const char* title, const TriMesh& mesh, const std::vector<zome::Ball
     std::printf("  faces %zu, labels %zu (outermost balls), k-nearest candidates: %zu graph nodes x labels = %zu pairs\n",
                 mesh.triangles.size(), labels.size(), r.graphNodes, r.candidatePairs);
     for (const ScheduleStep& s : r.schedule) {
-        std::printf("  w_smoothness %-8g E %.6g -> %.6g  partitions %zu  oversized %zu  sweeps %d  expansions %d  %.2f s\n",
-                    s.smoothnessWeight, s.energyNearest, s.energyGraphCut, s.partitions, s.oversized, s.sweeps,
-                    s.expansions, s.seconds);
+        std::printf("  w_smoothness %-8g faces %zu  E %.6g -> %.6g  partitions %zu  kept %zu  oversized %zu  sweeps %d  "
+                    "expansions %d  %.2f s\n",
+                    s.smoothnessWeight, s.faces, s.energyNearest, s.energyGraphCut, s.partitions, s.kept, s.oversized,
+                    s.sweeps, s.expansions, s.seconds);
         if (s.bandNodes > 0)
             std::printf("    clusters: E %.6g after %d sweeps, %d expansions; refinement band %zu of %zu nodes\n",
                         s.energyClusters, s.clusterSweeps, s.clusterExpansions, s.bandNodes, r.refineNodes);
@@ -133,6 +134,8 @@ int main(int argc, char** argv) {
             o.refineNodeTarget = size_t(std::atol(argv[++i]));
         else if (is("--graph-nodes"))
             o.graphNodeTarget = size_t(std::atol(argv[++i]));
+        else if (std::strcmp(argv[i], "--whole-surface-schedule") == 0)
+            o.refineOversizedOnly = false;  // the paper's schedule: every step re-cuts the whole surface
         else
             mode = argv[i];
     }

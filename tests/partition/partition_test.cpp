@@ -280,3 +280,60 @@ TEST_CASE("partition: bad inputs fail with clear messages") {
     // An empty mesh.
     CHECK_THROWS_AS(partitionSurface(TriMesh{}, frame, {0, 1}, {}, RunContext::silent()), Error);
 }
+
+TEST_CASE("partition: partitions that fit at a high w_smoothness are kept while the others are cut again") {
+    // The small bunny at 300 mm in a 120 mm printer: the first cut (w_smoothness 10) leaves some
+    // partitions that fit and some that do not. Only the latter may be cut again at lower weights;
+    // the paper's schedule (every step re-cuts the whole surface) would relabel all of them.
+    const partition::test::MeshMm bunny = partition::test::loadMeshMm(zomefab::test::dataPath("bunny_npm_3674.stl"), 300.0, true);
+    const partition::test::LatticeFrame frame = partition::test::makeLatticeFrame(bunny.mesh, 12.0);
+    PartitionOptions o;
+    o.printerMm = {120, 120, 120};
+    const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, o, RunContext::silent());
+    checkResult(bunny.mesh, r);
+
+    // The first step alone: its labelling, and which of its regions fit the printer.
+    PartitionOptions firstOnly = o;
+    firstOnly.smoothnessMin = o.smoothnessStart;
+    const PartitionResult r10 = partitionSurface(bunny.mesh, frame.structure, frame.outermost, firstOnly, RunContext::silent());
+    REQUIRE(r10.schedule.size() == 1);
+    const FaceGraph g = buildFaceGraph(bunny.mesh);
+    std::vector<uint32_t> compOf;
+    const uint32_t compCount = labelComponents(g, r10.graphCutLabels, compOf);
+    std::vector<std::vector<Vec3d>> pts(compCount);
+    for (size_t f = 0; f < compOf.size(); ++f)
+        for (uint32_t v : bunny.mesh.triangles[f]) pts[compOf[f]].push_back(toD(bunny.mesh.positions[v]));
+    std::vector<char> fits(compCount);
+    size_t fitCount = 0, fitFaces = 0;
+    for (uint32_t c = 0; c < compCount; ++c) {
+        fits[c] = fitInPrinter(pts[c], o.printerMm, o.fitMarginMm).fits ? 1 : 0;
+        fitCount += size_t(fits[c]);
+    }
+    // The case exercises the refinement: some regions fit at w_smoothness 10, some do not.
+    REQUIRE(fitCount >= 1);
+    REQUIRE(fitCount < compCount);
+    REQUIRE(r.schedule.size() >= 2);
+    CHECK(r.schedule[0].kept == fitCount);
+    CHECK(r.schedule[0].faces == bunny.mesh.triangles.size());
+    for (size_t f = 0; f < compOf.size(); ++f) fitFaces += size_t(fits[compOf[f]]);
+    CHECK(r.schedule[1].faces == bunny.mesh.triangles.size() - fitFaces);
+    for (size_t i = 1; i < r.schedule.size(); ++i) CHECK(r.schedule[i].faces <= r.schedule[i - 1].faces);
+
+    // Every face of a region that fit at w_smoothness 10 keeps its label from there.
+    auto changedFaces = [&](const PartitionResult& result) {
+        size_t changed = 0;
+        for (size_t f = 0; f < compOf.size(); ++f)
+            changed += (fits[compOf[f]] && result.graphCutLabels[f] != r10.graphCutLabels[f]) ? 1 : 0;
+        return changed;
+    };
+    CHECK(changedFaces(r) == 0);
+
+    // The paper's schedule re-cuts them (the check above tells the two apart) and ends with more
+    // pieces.
+    PartitionOptions whole = o;
+    whole.refineOversizedOnly = false;
+    const PartitionResult rw = partitionSurface(bunny.mesh, frame.structure, frame.outermost, whole, RunContext::silent());
+    checkResult(bunny.mesh, rw);
+    CHECK(changedFaces(rw) > 0);
+    CHECK(r.pieces.size() < rw.pieces.size());
+}

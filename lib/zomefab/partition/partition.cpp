@@ -258,27 +258,19 @@ struct Context {
     }
 };
 
-/// The regions (connected components of @p labels) that do not fit the printer, as face lists.
-std::vector<std::vector<uint32_t>> oversizedRegions(Context& cx, const std::vector<uint32_t>& labels, size_t* regionCount) {
-    std::vector<uint32_t> compOf;
-    const uint32_t n = labelComponents(cx.graph, labels, compOf);
-    if (regionCount) *regionCount = n;
-    std::vector<uint32_t> offsets, faces;
-    groupFaces(compOf, n, offsets, faces);
-    std::vector<char> isOver(n, 0);
-    // Vertex lists per region first (serial, one stamp array), then the fit tests in parallel.
+/// Does each of @p faceSets fit the printer (its vertices' oriented box, docs/partition.md §4)?
+/// Vertex lists are gathered serially (one stamp array), the fit tests run in parallel; the result
+/// does not depend on the thread count.
+std::vector<char> fitsEach(Context& cx, const std::vector<std::vector<uint32_t>>& faceSets) {
+    const size_t n = faceSets.size();
     std::vector<std::vector<Vec3d>> pts(n);
-    for (uint32_t c = 0; c < n; ++c)
-        pts[c] = faceVertices(cx.mesh, std::vector<uint32_t>(faces.begin() + offsets[c], faces.begin() + offsets[c + 1]),
-                              cx.stamp, cx.stampValue);
-    tbb::parallel_for(uint32_t(0), n, [&](uint32_t c) {
+    for (size_t c = 0; c < n; ++c) pts[c] = faceVertices(cx.mesh, faceSets[c], cx.stamp, cx.stampValue);
+    std::vector<char> fits(n, 1);
+    tbb::parallel_for(size_t(0), n, [&](size_t c) {
         if (fitsTrivially(pts[c], cx.opt.printerMm, cx.opt.fitMarginMm)) return;
-        isOver[c] = !fitInPrinter(pts[c], cx.opt.printerMm, cx.opt.fitMarginMm).fits;
+        fits[c] = fitInPrinter(pts[c], cx.opt.printerMm, cx.opt.fitMarginMm).fits ? 1 : 0;
     });
-    std::vector<std::vector<uint32_t>> out;
-    for (uint32_t c = 0; c < n; ++c)
-        if (isOver[c]) out.emplace_back(faces.begin() + offsets[c], faces.begin() + offsets[c + 1]);
-    return out;
+    return fits;
 }
 
 /// Splits @p faces (one class) into parts that each fit the printer, by recursive bisection
@@ -734,23 +726,107 @@ private:
 
     // --- fit schedule (§5.1) ---------------------------------------------------------------------
 
-    /// w_smoothness = 10, ×0.1 while a partition does not fit; split when it bottoms out.
+    /// A re-cut at w_smoothness @p ws of the faces flagged in @p isFree, every other face held at
+    /// its label in @p labels (its only candidate). Free nodes start from their nearest ball and may
+    /// take their k nearest. The problem keeps the face-level energy of the whole surface (held
+    /// nodes add constants), so the seam weight between a free face and a held neighbour counts:
+    /// free faces next to a kept partition join its label where that is cheaper than a new seam.
+    AlphaExpansionResult refineCut(double ws, const std::vector<uint32_t>& labels, const std::vector<char>& isFree,
+                                   ScheduleStep& st) const {
+        AlphaExpansionOptions ao;
+        ao.smoothnessWeight = ws;
+        ao.maxSweeps = mOpt.maxSweeps;
+        const size_t n = mUnits.count();
+        std::vector<uint32_t> start(n);
+        std::vector<char> isFreeNode(n);
+        for (size_t u = 0; u < n; ++u) {
+            // A node's faces share one label and are edge-connected, so they lie in one partition:
+            // all free or all held.
+            const uint32_t f = mUnits.faces[mUnits.offsets[u]];
+            isFreeNode[u] = isFree[f];
+            start[u] = isFree[f] ? mInitial[u] : labels[f];
+        }
+        // restrictToBand adds no candidate here: a free node's start (its nearest ball) is one already.
+        const LabelingProblem prob = restrictToBand(start, isFreeNode);
+        st.energyNearest = labelingEnergy(prob, start, ws);
+        st.bandNodes = size_t(std::count(isFreeNode.begin(), isFreeNode.end(), char(1)));
+        return alphaExpansion(prob, start, ao, mRun);
+    }
+
+    /// The fit schedule (docs/partition.md §4). The first step cuts the whole surface at
+    /// w_smoothness = smoothnessStart and keeps every partition that fits the printer. Each further
+    /// step multiplies w_smoothness by smoothnessFactor and re-cuts only the faces of the partitions
+    /// that did not fit, the kept ones held: a single oversized partition no longer sends the whole
+    /// surface to a lower smoothness (which gave many small pieces), and what already fits stays
+    /// large and smooth. When w_smoothness would fall below smoothnessMin, what still does not fit
+    /// is bisected. With refineOversizedOnly = false every step re-cuts the whole surface (the paper).
     void runSchedule() {
         const Stopwatch clock;
         Context& cx = context();
+        std::vector<uint32_t>& labels = mRes.graphCutLabels;
+        labels.assign(mFaceCount, 0);
+        std::vector<char> isFree(mFaceCount, 1);
+        // Kept partitions: per face its partition (kNone while free); per partition its label and the
+        // step that kept it, which decide its SVM class (below).
+        std::vector<uint32_t> regionOf(mFaceCount, kNone), regionLabel;
+        std::vector<int> regionStep;
+        std::vector<char> isWholeCutStep;               // per step: did it cut the whole surface?
+        std::vector<std::vector<uint32_t>> oversized;   // free faces of each partition that does not fit
+        std::vector<uint32_t> oversizedLabel;
         double ws = mOpt.smoothnessStart;
-        std::vector<std::vector<uint32_t>> oversized;
-        for (int step = 0;; ++step) {
+        int step = 0;
+        for (;; ++step) {
             const Stopwatch stepClock;
             ScheduleStep st;
             st.smoothnessWeight = ws;
-            const AlphaExpansionResult ae = graphCut(ws, st);
+            const bool isWholeCut = step == 0 || !mOpt.refineOversizedOnly;
+            if (isWholeCut) {
+                std::fill(isFree.begin(), isFree.end(), char(1));
+                std::fill(regionOf.begin(), regionOf.end(), kNone);
+            }
+            isWholeCutStep.push_back(isWholeCut ? 1 : 0);
+            st.faces = size_t(std::count(isFree.begin(), isFree.end(), char(1)));
+            const AlphaExpansionResult ae = isWholeCut ? graphCut(ws, st) : refineCut(ws, labels, isFree, st);
             st.energyGraphCut = ae.sweepEnergies.back();
             st.sweeps = ae.sweeps;
             st.expansions = ae.expansions;
-            mRes.graphCutLabels.resize(mFaceCount);
-            for (size_t f = 0; f < mFaceCount; ++f) mRes.graphCutLabels[f] = ae.labels[mUnits.unitOf[f]];
-            oversized = oversizedRegions(cx, mRes.graphCutLabels, &st.partitions);
+            for (size_t f = 0; f < mFaceCount; ++f)
+                if (isFree[f]) labels[f] = ae.labels[mUnits.unitOf[f]];
+
+            // Partitions: connected regions of one label over the whole surface. Only those with free
+            // faces are new; the others are kept partitions, unchanged. (Two kept partitions of one
+            // label are never edge-adjacent: each was a whole region when it was kept, so a region
+            // of its label next to it would have been part of it.)
+            std::vector<uint32_t> compOf, compOffsets, compFaces;
+            const uint32_t compCount = labelComponents(mGraph, labels, compOf);
+            groupFaces(compOf, compCount, compOffsets, compFaces);
+            std::vector<std::vector<uint32_t>> candidates;
+            for (uint32_t c = 0; c < compCount; ++c) {
+                const auto b = compFaces.begin() + compOffsets[c], e = compFaces.begin() + compOffsets[c + 1];
+                if (std::any_of(b, e, [&](uint32_t f) { return isFree[f] != 0; })) candidates.emplace_back(b, e);
+            }
+            const std::vector<char> fits = fitsEach(cx, candidates);
+            oversized.clear();
+            oversizedLabel.clear();
+            for (size_t i = 0; i < candidates.size(); ++i) {
+                const uint32_t label = labels[candidates[i].front()];
+                if (fits[i]) {
+                    // Kept, together with any kept partition its free faces joined (the union fits).
+                    const uint32_t r = uint32_t(regionLabel.size());
+                    regionLabel.push_back(label);
+                    regionStep.push_back(step);
+                    for (uint32_t f : candidates[i]) regionOf[f] = r, isFree[f] = 0;
+                    ++st.kept;
+                } else {
+                    // Its kept faces stay kept; its free faces are cut again at the next step.
+                    std::vector<uint32_t> freeFaces;
+                    for (uint32_t f : candidates[i])
+                        if (isFree[f]) freeFaces.push_back(f);
+                    oversized.push_back(std::move(freeFaces));
+                    oversizedLabel.push_back(label);
+                }
+            }
+            st.partitions = compCount;
             st.oversized = oversized.size();
             st.seconds = stepClock.seconds();
             mRes.schedule.push_back(st);
@@ -759,8 +835,10 @@ private:
             mRes.energyGraphCut = st.energyGraphCut;
             mRes.sweepEnergies = ae.sweepEnergies;
             mRes.graphCutPartitions = st.partitions;
-            mRun.info(fmt("w_smoothness %g: E %.6g -> %.6g, %.0f partitions", ws, st.energyNearest, st.energyGraphCut,
-                          double(st.partitions)) +
+            mRun.info(fmt("w_smoothness %g: ", ws) +
+                      (isWholeCut ? std::string()
+                                  : "re-cut " + std::to_string(st.faces) + " faces of the partitions that did not fit, ") +
+                      fmt("E %.6g -> %.6g, %.0f partitions", st.energyNearest, st.energyGraphCut, double(st.partitions)) +
                       (oversized.empty() ? ", all fit the printer" : ", " + std::to_string(oversized.size()) + " too large"));
             if (!ae.isConverged)
                 mRun.warn(fmt("graph cut at w_smoothness %g stopped after %.0f sweeps before converging", ws, double(ae.sweeps)));
@@ -774,15 +852,36 @@ private:
         }
         mRes.secondsGraphCut = clock.seconds();
 
-        // Training classes: the graph-cut labels, plus new classes for split parts.
-        mTrainClass = mRes.graphCutLabels;
+        // SVM training classes. Class l = label l for the partitions a whole-surface cut kept (as in
+        // the paper: one class per ball); a partition kept by a re-cut gets a class per (step, label),
+        // so it is never one class with a kept partition of the same ball next to it.
         mClassBall.assign(mLabelBalls.begin(), mLabelBalls.end());
-        if (mRes.isScheduleBottomedOut) {
-            for (const auto& region : oversized) mRes.splits += splitFaces(region) ? 1 : 0;
+        std::map<std::pair<int, uint32_t>, uint32_t> classOfKey;
+        auto classFor = [&](int keptStep, uint32_t label) {
+            if (isWholeCutStep[size_t(keptStep)]) return label;
+            auto it = classOfKey.find({keptStep, label});
+            if (it != classOfKey.end()) return it->second;
+            mClassBall.push_back(mLabelBalls[label]);
+            const uint32_t c = uint32_t(mClassBall.size() - 1);
+            classOfKey.emplace(std::make_pair(keptStep, label), c);
+            return c;
+        };
+        std::vector<uint32_t> regionClass(regionLabel.size());
+        for (size_t r = 0; r < regionLabel.size(); ++r) regionClass[r] = classFor(regionStep[r], regionLabel[r]);
+        mTrainClass.assign(mFaceCount, 0);
+        for (size_t f = 0; f < mFaceCount; ++f)
+            if (regionOf[f] != kNone) mTrainClass[f] = regionClass[regionOf[f]];
+        // The schedule bottomed out: bisect what still does not fit. Its first part keeps the class
+        // of its (step, label), every other part gets a class of its own.
+        for (size_t i = 0; i < oversized.size(); ++i) {
+            const uint32_t c = classFor(step, oversizedLabel[i]);
+            for (uint32_t f : oversized[i]) mTrainClass[f] = c;
+            mRes.splits += splitFaces(oversized[i]) ? 1 : 0;
+        }
+        if (mRes.isScheduleBottomedOut)
             mRun.warn(fmt("the fit schedule bottomed out at w_smoothness %g with %.0f partitions larger than the "
                           "printer; split them",
                           ws, double(oversized.size())));
-        }
     }
 
     Context& context() {

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file Surface partition (paper §5): label the shell's outer triangles with the frame's outermost
-/// balls by a multi-label graph cut (Eq. 1–4), lower w_smoothness until every partition fits the
-/// printer, replace the zig-zag seams by planar cuts from a multi-class linear SVM, and turn the
-/// cells into connected pieces that fit the printer. docs/partition.md explains each step.
+/// balls by a multi-label graph cut (Eq. 1–4), cut the partitions that do not fit the printer again
+/// at lower w_smoothness (the ones that fit are kept) until all fit, replace the zig-zag seams by
+/// planar cuts from a multi-class linear SVM, and turn the cells into connected pieces that fit the
+/// printer. docs/partition.md explains each step.
 ///
 /// @code
 ///   TriMesh meshMm = readMesh(path);  transformInPlace(meshMm, transformMm);
@@ -48,6 +49,11 @@ struct PartitionOptions {
     /// The schedule bottoms out when the next w_smoothness would fall below this; oversized
     /// partitions are then split (and the result says so).
     double smoothnessMin = 1e-3;
+    /// true (default): only the partitions that do not fit are cut again at the next, lower
+    /// w_smoothness; the ones that fit are kept as they are, so one oversized partition does not
+    /// turn the whole surface into small pieces. false: every step cuts the whole surface again
+    /// (the paper's schedule).
+    bool refineOversizedOnly = true;
     Vec3d printerMm{200.0, 200.0, 200.0};  ///< build volume, mm (about the paper's Ultimaker 3)
     /// Every side of a piece's oriented box is grown by this much before the fit test, for the
     /// shell's thickness behind the surface and the connectors (mm).
@@ -89,10 +95,15 @@ struct PartitionOptions {
 /// One step of the fit schedule.
 struct ScheduleStep {
     double smoothnessWeight = 0.0;
-    double energyNearest = 0.0;   ///< E of the starting (nearest-ball) labelling at this weight
+    /// E (face level, whole surface) at this weight of the starting labelling: the nearest ball on
+    /// the faces this step cuts, the kept regions as they are.
+    double energyNearest = 0.0;
     double energyGraphCut = 0.0;  ///< E after alpha-expansion
-    size_t partitions = 0;        ///< connected label regions
+    size_t partitions = 0;        ///< connected label regions of the whole surface after this step
     size_t oversized = 0;         ///< regions that do not fit the printer
+    size_t faces = 0;             ///< faces this step cut: all at a whole-surface cut, else those of
+                                  ///< the regions that did not fit at the step before
+    size_t kept = 0;              ///< regions this step kept (they fit; later steps leave them alone)
     int sweeps = 0;               ///< node-level passes (the band refinement with two levels)
     int expansions = 0;           ///< node-level max-flow solves
     // With two levels (graphNodeTarget): the cluster-level cut and the refinement band.
@@ -119,7 +130,8 @@ struct PartitionResult {
     double fitMarginMm = 0.0;
     std::vector<zome::BallId> labelBalls;   ///< label index → ball id (the input N_out order)
     std::vector<uint32_t> nearestLabels;    ///< per face: label of the nearest ball
-    std::vector<uint32_t> graphCutLabels;   ///< per face: label after the accepted graph cut
+    std::vector<uint32_t> graphCutLabels;   ///< per face: label after the fit schedule (each region as
+                                            ///< the step that kept it cut it)
     LinearCells cells;                      ///< argmax cells in mm
     std::vector<zome::BallId> cellBalls;    ///< cell → the ball it attaches to
     std::vector<uint32_t> faceCells;        ///< per face: the cell containing its centroid
@@ -130,12 +142,12 @@ struct PartitionResult {
     size_t salientRegionsSplit = 0;         ///< regions a final seam still crosses (0 normally)
 
     std::vector<ScheduleStep> schedule;
-    double smoothnessWeight = 0.0;          ///< the accepted w_smoothness
-    double energyNearest = 0.0;             ///< E(nearest-ball labelling) at that weight
-    double energyGraphCut = 0.0;            ///< E(graph cut) at that weight
-    std::vector<double> sweepEnergies;      ///< of the accepted graph cut
+    double smoothnessWeight = 0.0;          ///< w_smoothness of the last schedule step
+    double energyNearest = 0.0;             ///< the last step's ScheduleStep::energyNearest
+    double energyGraphCut = 0.0;            ///< the last step's ScheduleStep::energyGraphCut
+    std::vector<double> sweepEnergies;      ///< of the last step's graph cut
     size_t nearestPartitions = 0;           ///< connected regions of the nearest-ball labelling
-    size_t graphCutPartitions = 0;          ///< connected regions of the graph cut
+    size_t graphCutPartitions = 0;          ///< connected regions of graphCutLabels (before splits)
     bool isScheduleBottomedOut = false;     ///< the schedule ended without every partition fitting
     size_t splits = 0;                      ///< partitions/pieces split to fit the printer
     size_t merges = 0;                      ///< small pieces merged into a neighbour

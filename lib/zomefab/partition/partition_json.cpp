@@ -74,6 +74,8 @@ json partitionToJson(const PartitionResult& r, const PartitionOptions& o, const 
                             {"energy_graph_cut", s.energyGraphCut},
                             {"partitions", s.partitions},
                             {"oversized", s.oversized},
+                            {"faces", s.faces},
+                            {"kept", s.kept},
                             {"sweeps", s.sweeps},
                             {"expansions", s.expansions}});
     j["energy"] = {{"w_data", o.dataWeight},
