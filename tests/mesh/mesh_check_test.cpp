@@ -363,7 +363,10 @@ TEST_CASE("removeCavities: drops a sealed inner pocket, keeps the solid and sepa
         for (Triangle t : part->triangles) m.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
     }
     REQUIRE(mesh::checkMesh(m).volume == doctest::Approx(1000 - 12 + 8));
-    const mesh::CavityRemoval removal = mesh::removeCavities(m);
+    TriMesh keepAll = m;
+    CHECK(mesh::removeCavities(keepAll, 11.9).cavities == 0);  // the pocket is larger than allowed
+    CHECK(keepAll.triangles == m.triangles);
+    const mesh::CavityRemoval removal = mesh::removeCavities(m, 12.1);
     CHECK(removal.cavities == 1);
     CHECK(removal.volumeMm3 == doctest::Approx(12));
     const mesh::MeshReport after = mesh::checkMesh(m);
@@ -373,6 +376,6 @@ TEST_CASE("removeCavities: drops a sealed inner pocket, keeps the solid and sepa
     CHECK(after.isClosed());
 
     TriMesh plain = solid;
-    CHECK(mesh::removeCavities(plain).cavities == 0);
+    CHECK(mesh::removeCavities(plain, 1e9).cavities == 0);
     CHECK(plain.triangles == solid.triangles);
 }

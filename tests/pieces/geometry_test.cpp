@@ -16,6 +16,7 @@
 #include "zomefab/pieces/label.h"
 #include "zomefab/pieces/orientation.h"
 #include "zomefab/pieces/tenons.h"
+#include "zomefab/report/slicer.h"
 #include "zomefab/zome/golden.h"
 #include "zomefab/zome/zome_system.h"
 
@@ -328,7 +329,7 @@ TEST_CASE("orientation: the largest cut face goes down, turned to fit the bed") 
     CHECK(faces[1].areaMm2 == doctest::Approx(60 * 40));
     std::vector<Vec3d> points;
     for (const Vec3f& p : box.positions) points.push_back(toD(p));
-    const PrintOrientation o = orientForPrinter(points, faces, {200, 200, 200});
+    const PrintOrientation o = orientForPrinter(box, faces, {200, 200, 200});
     CHECK(o.fits);
     CHECK(o.isCutFaceDown);
     CHECK(o.downNormal == Vec3d{1, 0, 0});
@@ -344,31 +345,82 @@ TEST_CASE("orientation: the largest cut face goes down, turned to fit the bed") 
 
     // The largest face down needs a 150 mm bed side (more than a 100 mm bed's diagonal allows
     // for a 40 mm width): the next face is used.
-    const PrintOrientation second = orientForPrinter(points, faces, {100, 100, 160});
+    const PrintOrientation second = orientForPrinter(box, faces, {100, 100, 160});
     CHECK(second.fits);
     CHECK(second.isCutFaceDown);
     CHECK(second.downNormal == Vec3d{0, 0, -1});
     CHECK(second.extentsMm[2] == doctest::Approx(150));
-    const PrintOrientation flat = orientForPrinter(points, faces, {250, 250, 45});
+    const PrintOrientation flat = orientForPrinter(box, faces, {250, 250, 45});
     CHECK(flat.fits);
     CHECK(!flat.isCutFaceDown);  // neither cut face fits: lying on a 40 mm side
-    CHECK(flat.extentsMm[2] <= 45);
+    CHECK(flat.extentsMm[2] == doctest::Approx(40));
+    CHECK(flat.baseAreaMm2 == doctest::Approx(60 * 150));
+    CHECK(flat.note.find("2 too large for the printer") != std::string::npos);
 }
 
 TEST_CASE("orientation: a long piece fits diagonally; one too large fits nowhere") {
     const TriMesh rod = zomefab::test::makeBox({0, 0, 0}, {250, 20, 20});
-    std::vector<Vec3d> points;
-    for (const Vec3f& p : rod.positions) points.push_back(toD(p));
-    const PrintOrientation o = orientForPrinter(points, {}, {200, 200, 200});
+    const PrintOrientation o = orientForPrinter(rod, {}, {200, 200, 200});
     CHECK(o.fits);
     CHECK(o.extentsMm[0] <= 200 + 1e-9);
     CHECK(o.extentsMm[1] <= 200 + 1e-9);
+    CHECK(o.baseAreaMm2 == doctest::Approx(250 * 20));  // flat on a long side, across the bed
     const TriMesh big = zomefab::test::makeBox({0, 0, 0}, {300, 300, 300});
-    points.clear();
-    for (const Vec3f& p : big.positions) points.push_back(toD(p));
-    const PrintOrientation none = orientForPrinter(points, {}, {200, 200, 200});
+    const PrintOrientation none = orientForPrinter(big, {}, {200, 200, 200});
     CHECK(!none.fits);
     CHECK(none.ratio > 1);
+}
+
+TEST_CASE("orientation: the base is the cross-section one first layer above the lowest point") {
+    const TriMesh cube = zomefab::test::makeBox({0, 0, 0}, {10, 10, 10});
+    CHECK(baseAreaMm2(cube, {0, 0, -1}) == doctest::Approx(100));
+    CHECK(baseAreaMm2(cube, {0, 1, 0}, 3.0) == doctest::Approx(100));
+    // On an edge: a strip 2·h wide; on a corner: the triangle with corners at h·√3 on each edge.
+    const double s = std::sqrt(0.5), h = kBaseHeightMm;
+    CHECK(baseAreaMm2(cube, {-s, -s, 0}) == doctest::Approx(10 * 2 * h));
+    const double c = 1 / std::sqrt(3.0), a = h * std::sqrt(3.0);
+    CHECK(baseAreaMm2(cube, {-c, -c, -c}) == doctest::Approx(std::sqrt(3.0) / 2 * a * a));
+}
+
+TEST_CASE("orientation: a piece no cut face can carry rests on its largest side, not on a corner") {
+    // A 30 × 30 × 190 mm bar whose one cut face lies across its middle (x = 15): the piece reaches
+    // 15 mm beyond it, as a piece merged from several cells reaches beyond its faces. The old rule,
+    // "the direction with the most room", stood the bar on a corner, where PrusaSlicer finds "no
+    // extrusions in the first layer".
+    const TriMesh bar = zomefab::test::makeBox({0, 0, 0}, {30, 30, 190});
+    const std::vector<CutFace> faces = {{{1, 0, 0}, -15.0, 30 * 190}};
+    const PrintOrientation o = orientForPrinter(bar, faces, {200, 200, 200});
+    CHECK(o.fits);
+    CHECK(!o.isCutFaceDown);
+    INFO(o.note);
+    CHECK(o.note.find("1 with the piece beyond them by 15 mm") != std::string::npos);
+    CHECK(o.baseAreaMm2 == doctest::Approx(30 * 190));
+    CHECK(o.extentsMm[2] == doctest::Approx(30));
+    // Measured on the placed mesh: the facets on the bed, facing down.
+    TriMesh placed = bar;
+    transformInPlace(placed, o.transformMm);
+    double bedMm2 = 0;
+    for (const Triangle& t : placed.triangles) {
+        const Vec3d a = toD(placed.positions[t[0]]), b = toD(placed.positions[t[1]]), c = toD(placed.positions[t[2]]);
+        const Vec3d n = cross(sub(b, a), sub(c, a));
+        if (std::max({a[2], b[2], c[2]}) < 1e-3 && n[2] < 0) bedMm2 += 0.5 * norm(n);
+    }
+    CHECK(bedMm2 == doctest::Approx(30 * 190).epsilon(1e-4));
+    // A cut face under kMinCutFaceAreaMm2 does not win over a large side either.
+    const std::vector<CutFace> sliver = {{{0, 0, -1}, 0.0, 0.5 * kMinCutFaceAreaMm2}};
+    const PrintOrientation side = orientForPrinter(bar, sliver, {200, 200, 200});
+    CHECK(side.baseAreaMm2 == doctest::Approx(30 * 190));
+    CHECK(side.note.find("1 under 100 mm²") != std::string::npos);
+
+    if (!report::isSlicerAvailable()) {
+        MESSAGE("prusa-slicer is not installed (apt-get install --no-install-recommends prusa-slicer): skipped");
+        return;
+    }
+    // The project's profile (report::prusaSlicerArguments); it throws on "no extrusions in the
+    // first layer".
+    const report::PrintEstimate e = report::sliceWithPrusaSlicer(placed, report::PrintSettings{}, "bar");
+    CHECK(e.seconds > 0);
+    CHECK(e.filamentMm3 > 0);
 }
 
 TEST_CASE("label: seven-segment strokes, an underline, centred") {

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include "test_util.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/pieces/detail/vec.h"
@@ -18,30 +19,6 @@ using namespace detail;
 
 namespace {
 
-/// A closed, outward UV sphere (poles fanned).
-TriMesh uvSphere(const Vec3d& c, double r, int rings, int segments) {
-    TriMesh m;
-    const double pi = std::acos(-1.0);
-    m.positions.push_back({float(c[0]), float(c[1]), float(c[2] + r)});
-    for (int i = 1; i < rings; ++i)
-        for (int j = 0; j < segments; ++j) {
-            const double theta = pi * i / rings, phi = 2 * pi * j / segments;
-            m.positions.push_back({float(c[0] + r * std::sin(theta) * std::cos(phi)),
-                                   float(c[1] + r * std::sin(theta) * std::sin(phi)), float(c[2] + r * std::cos(theta))});
-        }
-    m.positions.push_back({float(c[0]), float(c[1]), float(c[2] - r)});
-    const uint32_t south = uint32_t(m.positions.size() - 1);
-    auto ring = [&](int i, int j) { return uint32_t(1 + (i - 1) * segments + (j % segments)); };
-    for (int j = 0; j < segments; ++j) m.triangles.push_back({0, ring(1, j), ring(1, j + 1)});
-    for (int i = 1; i < rings - 1; ++i)
-        for (int j = 0; j < segments; ++j) {
-            m.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
-            m.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
-        }
-    for (int j = 0; j < segments; ++j) m.triangles.push_back({south, ring(rings - 1, j + 1), ring(rings - 1, j)});
-    return m;
-}
-
 void writeFile(const std::string& path, const std::string& bytes) {
     std::ofstream out(path, std::ios::binary);
     out.write(bytes.data(), std::streamsize(bytes.size()));
@@ -54,7 +31,7 @@ sdf::LevelSet makeSphereShell(const Vec3d& c, double r, double t, double voxel) 
     sdf::MeshToLevelSetOptions o;
     o.voxelMm = voxel;
     o.interiorBandMm = t;
-    const TriMesh sphere = uvSphere(c, r, 96, 192);
+    const TriMesh sphere = zomefab::test::makeSphere(c, r, 96, 192);
     const sdf::LevelSet object = sdf::meshToLevelSet(sphere, o, RunContext::silent());
     return sdf::makeShell(object, {t}, RunContext::silent());
 }

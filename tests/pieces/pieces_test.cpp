@@ -16,6 +16,7 @@
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/mesh/mesh_check.h"
 #include "zomefab/pieces/detail/vec.h"
+#include "zomefab/pieces/orientation.h"
 #include "zomefab/pieces/pieces.h"
 #include "zomefab/pieces/pieces_io.h"
 #include "zomefab/zome/zome_system.h"
@@ -81,6 +82,11 @@ void checkClosedAndFits(const Pieces& result) {
             if (n[2] < 0) bedArea += 0.5 * norm(n);
         }
         if (p.isCutFaceDown) CHECK(bedArea > 50.0);
+        // Every piece, cut face down or not, stands on a base the first layer can print (a piece
+        // on a point or an edge is what PrusaSlicer refuses: "no extrusions in the first layer").
+        const double baseMm2 = baseAreaMm2(p.mesh, {0, 0, -1});
+        CHECK(baseMm2 > 50.0);
+        CHECK(p.baseAreaMm2 == doctest::Approx(baseMm2).epsilon(1e-6));
     }
 }
 

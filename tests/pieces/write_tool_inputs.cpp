@@ -1,5 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // write_tool_inputs DIR: the zf-pieces inputs of pieces_fixtures.h, for the CLI tests.
+// The fixtures use the shared mesh builders of tests/test_util (zomefab_test_main), whose header
+// includes doctest: this program carries doctest's implementation, but not its main, so that
+// the linker never pulls in doctest's main from zomefab_test_main.
+#define DOCTEST_CONFIG_IMPLEMENT
+#include <doctest/doctest.h>
+
 #include <cstdio>
 #include <exception>
 

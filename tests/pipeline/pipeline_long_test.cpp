@@ -206,7 +206,7 @@ TEST_CASE("long: the estimator agrees with PrusaSlicer within 15 % on the pieces
     }
     // Slicing all 2 × (pieces + baseline parts) takes about 20 minutes on 2 cores (`zomefab run
     // --slicer prusa-slicer` does it; docs/report.md has that run's table), so the test slices a fixed
-    // sample: every fourth piece and every third baseline part at 20 %, every twelfth piece and every
+    // sample: every other piece and every third baseline part at 20 %, every fourth piece and every
     // sixth part at 100 %, and compares the sample's sums.
     const DemoRun& d = demo();
     const report::CostOptions& cost = d.options.cost;
@@ -225,9 +225,9 @@ TEST_CASE("long: the estimator agrees with PrusaSlicer within 15 % on the pieces
     };
     std::vector<TriMesh> printed;
     for (const pieces::Piece& p : d.result.pieces.pieces) printed.push_back(p.mesh);
-    const Sample samples[] = {{"pieces", every(4, printed), cost.hollowInfillPercent},
+    const Sample samples[] = {{"pieces", every(2, printed), cost.hollowInfillPercent},
                               {"baseline", every(3, baseline), cost.hollowInfillPercent},
-                              {"pieces", every(12, printed), cost.solidInfillPercent},
+                              {"pieces", every(4, printed), cost.solidInfillPercent},
                               {"baseline", every(6, baseline), cost.solidInfillPercent}};
     for (const Sample& sample : samples) {
         report::PrintSettings settings = cost.print;

@@ -27,7 +27,9 @@ struct FrameOptions {
     EnergyOptions energy;        ///< weights; targetItemCount is replaced by the τ estimate
     TargetCountOptions target;   ///< how τ is estimated (or fixed)
     AnnealOptions anneal;        ///< cooling schedule and budgets
-    int chains = 1;              ///< independent annealing chains; the best is kept
+    /// Independent annealing chains run in parallel; the best is kept. 8: on the demo bunny at 400 mm
+    /// the best of 8 has E = 117.5 against 126.4 for one chain, in 0.08 s on 2 cores (32: 116.2).
+    int chains = 8;
     uint64_t seed = 1;           ///< chains and τ runs derive their seeds from it
     double surfaceSampleSpacingMm = 6.0;  ///< surface samples for the gap measure
     /// Debug: after every accepted move, verifyFrame() and a full energy recomputation; the first

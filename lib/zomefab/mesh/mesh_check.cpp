@@ -570,7 +570,7 @@ TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const s
     return mesh;
 }
 
-CavityRemoval removeCavities(TriMesh& mesh) {
+CavityRemoval removeCavities(TriMesh& mesh, double maxVolumeMm3) {
     DisjointSets sets(mesh.vertexCount());
     for (const Triangle& t : mesh.triangles) sets.unite(t[0], t[1]), sets.unite(t[1], t[2]);
     // Volumes about the bounding-box centre, to keep the sums well conditioned far from the origin.
@@ -583,16 +583,17 @@ CavityRemoval removeCavities(TriMesh& mesh) {
         const Vec3d c = sub(toDouble(mesh.positions[t[2]]), centre);
         volume[sets.find(t[0])] += dot(a, cross(b, c)) / 6.0;
     }
+    auto isSmallCavity = [&](uint32_t root) { return volume[root] < 0.0 && -volume[root] <= maxVolumeMm3; };
     CavityRemoval removal;
     for (uint32_t v = 0; v < mesh.vertexCount(); ++v)
-        if (sets.find(v) == v && volume[v] < 0.0) ++removal.cavities, removal.volumeMm3 -= volume[v];
+        if (sets.find(v) == v && isSmallCavity(v)) ++removal.cavities, removal.volumeMm3 -= volume[v];
     if (removal.cavities == 0) return removal;
 
     TriMesh kept;
     std::vector<uint32_t> newIndex(mesh.vertexCount(), UINT32_MAX);
     for (size_t i = 0; i < mesh.triangles.size(); ++i) {
         const Triangle& t = mesh.triangles[i];
-        if (volume[sets.find(t[0])] < 0.0) continue;
+        if (isSmallCavity(sets.find(t[0]))) continue;
         Triangle out;
         for (int c = 0; c < 3; ++c) {
             uint32_t& index = newIndex[t[size_t(c)]];

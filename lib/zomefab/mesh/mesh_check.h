@@ -44,12 +44,13 @@ struct CavityRemoval {
     double volumeMm3 = 0.0;  ///< their total volume (positive)
 };
 
-/// Drops the vertex-connected components of negative signed volume from a closed, outward mesh:
-/// cavities sealed inside the solid (e.g. a gap a voxel wide left between two unioned level sets),
-/// which a slicer would print as empty pockets and which make admesh count extra parts. The solid
-/// is then full there. Unused vertices are dropped; the other triangles keep their order.
+/// Drops the vertex-connected components of negative signed volume up to @p maxVolumeMm3 from a
+/// closed, outward mesh: small cavities sealed inside the solid (e.g. a gap a voxel wide left between
+/// two unioned level sets), which a slicer would print as empty pockets and which make admesh count
+/// extra parts. The solid is then full there. Larger cavities are kept: the hollow inside a closed
+/// shell is one. Unused vertices are dropped; the other triangles keep their order.
 /// Deterministic, O(F α(V)).
-CavityRemoval removeCavities(TriMesh& mesh);
+CavityRemoval removeCavities(TriMesh& mesh, double maxVolumeMm3);
 
 struct ValidateOptions {
     /// |volume| below this fraction of the bounding-box diagonal cubed counts as zero volume

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file Print preparation: the planar cut faces of a piece mesh, and the rotation that puts the
-/// largest cut face that allows it on the printer's bed with the piece inside the build volume.
+/// largest cut face that allows it on the printer's bed with the piece inside the build volume, or
+/// else the largest base the piece can rest on.
 /// No OpenVDB here. docs/pieces.md, "Orientation".
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "zomefab/core/transform.h"
@@ -23,6 +25,24 @@ struct CutFace {
 /// candidate planes (area ignored); the result keeps those with area, largest first.
 std::vector<CutFace> measureCutFaces(const TriMesh& meshMm, const std::vector<CutFace>& planes, double toleranceMm);
 
+/// Height above the bed at which a piece's base is measured: about one first layer (PrusaSlicer
+/// slices a 0.2–0.3 mm first layer at its middle). A piece whose cross-section there is a point
+/// leaves the slicer "no extrusions in the first layer".
+constexpr double kBaseHeightMm = 0.2;
+/// How far a piece may reach beyond the plane of the cut face it lies on. The adaptive mesher
+/// leaves vertices up to about 0.1 voxel off a cut plane (measured on the bunny: 0.016–0.093 mm at
+/// 1 mm voxels, so a 10 µm limit refused most faces of multi-cell pieces); half kBaseHeightMm
+/// keeps the whole face inside the first layer.
+constexpr double kFlatToleranceMm = 0.5 * kBaseHeightMm;
+/// A cut face smaller than this (a 10 × 10 mm patch) is not trusted to hold the piece on the bed
+/// by itself: the base search below may find a larger one.
+constexpr double kMinCutFaceAreaMm2 = 100.0;
+
+/// Area of the cross-section of the closed mesh @p meshMm at @p heightMm above its lowest point
+/// along @p down (unit): what would touch the bed, and be printed in the first layer, were @p down
+/// to point down. mm².
+double baseAreaMm2(const TriMesh& meshMm, const Vec3d& down, double heightMm = kBaseHeightMm);
+
 /// How a piece sits in the printer.
 struct PrintOrientation {
     bool fits = false;              ///< inside the build volume
@@ -31,14 +51,20 @@ struct PrintOrientation {
     Transform4d transformMm;        ///< input mm → printer mm: on the bed (z = 0), centred in x and y
     Vec3d extentsMm{0, 0, 0};       ///< size along the printer's x, y, z
     double ratio = 0.0;             ///< max over axes of extent / printer size (≤ 1 fits)
+    double baseAreaMm2 = 0.0;       ///< baseAreaMm2() on the bed: the first layer's area
+    /// Why no cut face lies on the bed, and what the piece rests on instead; empty when one does.
+    std::string note;
 };
 
-/// The orientation of the points @p pointsMm (a piece's vertices) for a printer of @p printerMm
-/// (x, y = bed, z = height). Tries the cut faces, largest first, that no point lies beyond by more
-/// than @p flatToleranceMm, each turned about the vertical for the best fit on the bed; the first
-/// that fits wins. Otherwise searches 6 axis and 250 sphere directions for the one with the most
-/// room; fits = false when none fits. Deterministic.
-PrintOrientation orientForPrinter(const std::vector<Vec3d>& pointsMm, const std::vector<CutFace>& cutFaces,
-                                  const Vec3d& printerMm, double flatToleranceMm = 0.01);
+/// The orientation of the closed mesh @p meshMm (a piece) for a printer of @p printerMm (x, y =
+/// bed, z = height). Tries the cut faces of at least kMinCutFaceAreaMm2, largest first, that no
+/// vertex lies beyond by more than @p flatToleranceMm, each turned about the vertical for the best
+/// fit on the bed; the first that fits wins. Otherwise the piece rests where it touches the bed
+/// most: among the cut faces' normals, the normals of the mesh's largest facets and 256 sphere
+/// directions (the best few that fit refined by small tilts), the one that fits with the largest
+/// area of down-facing facets within kBaseHeightMm of the bed, weighted by their closeness to it.
+/// When nothing fits, the orientation with the most room, fits = false. Deterministic.
+PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFace>& cutFaces,
+                                  const Vec3d& printerMm, double flatToleranceMm = kFlatToleranceMm);
 
 }  // namespace zomefab::pieces

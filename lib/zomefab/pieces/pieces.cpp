@@ -705,20 +705,27 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
             out.pieces[p].tenons = std::move(plan.perPiece[p]);
             out.pieces[p].tenonShortfall = std::move(plan.shortfall[p]);
         }
+        // The reasons summed over the pieces that fall short, most frequent first. (Naming the
+        // first such piece's top reason misled: its reasons were often one each, and the tie went
+        // to the alphabetically first, "crosses another piece", though on the bunny at 400 mm that
+        // rejected 7 of 136 rays against 52 "too far from the wall".)
         size_t few = 0;
-        std::string example;
+        std::map<std::string, int> reasons;
         for (const Piece& piece : out.pieces)
             if (piece.tenons.size() < size_t(opt.tenons.minPerPiece)) {
-                if (few++ == 0) {
-                    example = "piece " + std::to_string(piece.id) + " has " + std::to_string(piece.tenons.size());
-                    const auto top = std::max_element(piece.tenonShortfall.begin(), piece.tenonShortfall.end(),
-                                                      [](const auto& a, const auto& b) { return a.second < b.second; });
-                    if (top != piece.tenonShortfall.end()) example += " (mostly: " + top->first + ")";
-                }
+                ++few;
+                for (const auto& [why, count] : piece.tenonShortfall) reasons[why] += count;
             }
-        if (few > 0)
+        if (few > 0) {
+            std::vector<std::pair<int, std::string>> ranked;
+            for (const auto& [why, count] : reasons) ranked.push_back({-count, why});
+            std::sort(ranked.begin(), ranked.end());
+            std::string list;
+            for (const auto& [negCount, why] : ranked) list += (list.empty() ? "" : ", ") + why + " " + std::to_string(-negCount);
             context.warn(std::to_string(few) + " of " + std::to_string(pieceCount) + " pieces have fewer than " +
-                         std::to_string(opt.tenons.minPerPiece) + " tenons, e.g. " + example + "; pieces.json lists why");
+                         std::to_string(opt.tenons.minPerPiece) + " tenons (rejected rays: " + list +
+                         "); pieces.json lists why per piece");
+        }
     }
     context.throwIfCancelled();
     if (opt.label.isEnabled) {
@@ -868,11 +875,19 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
     context.throwIfCancelled();
     context.debug("meshed: " + number(clock.seconds(), 3) + " s");
 
+    std::vector<std::string> orientationNotes(pieceCount);  // reported in piece order below
     tbb::parallel_for(tbb::blocked_range<size_t>(0, pieceCount, 1), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t p = range.begin(); p < range.end(); ++p) {
             Piece& piece = out.pieces[p];
             const CellSet& set = cellSets[p];
             TriMesh mesh = std::move(meshes[p]);
+            // Sealed pockets of a few voxels (seen up to 28 voxels, where a tenon prism meets a
+            // tilted wall) would be printed as empty pockets and make admesh count extra parts: fill
+            // them. An uncut closed shell keeps its hollow, which is far larger.
+            const mesh::CavityRemoval cavities = mesh::removeCavities(mesh, 1000.0 * voxel * voxel * voxel);
+            if (cavities.cavities > 0)
+                context.debug("piece " + std::to_string(p) + ": filled " + std::to_string(cavities.cavities) +
+                              " sealed cavities of " + number(cavities.volumeMm3) + " mm³");
             const mesh::MeshReport report = mesh::checkMesh(mesh);
             if (report.boundaryEdges > 0 || report.nonManifoldEdges > 0 || !(report.volume > 0))
                 throw Error(ErrorCode::ProcessingFailed,
@@ -893,10 +908,8 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
                     planes.push_back({scale(sub(cells.w[j], cells.w[k]), inv), (cells.b[j] - cells.b[k]) * inv, 0.0});
                 }
             const std::vector<CutFace> faces = measureCutFaces(mesh, planes, 0.05 * voxel);
-            std::vector<Vec3d> points;
-            points.reserve(mesh.positions.size());
-            for (const Vec3f& v : mesh.positions) points.push_back(toD(v));
-            const PrintOrientation orientation = orientForPrinter(points, faces, opt.printerMm);
+            const PrintOrientation orientation = orientForPrinter(mesh, faces, opt.printerMm);
+            orientationNotes[p] = orientation.note;
             if (!orientation.fits) {
                 const Vec3d e = orientation.extentsMm;
                 throw Error(ErrorCode::ProcessingFailed,
@@ -909,12 +922,22 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
             piece.gridToPrintMm = orientation.transformMm;
             piece.isCutFaceDown = orientation.isCutFaceDown;
             piece.downNormalGridMm = orientation.downNormal;
+            piece.baseAreaMm2 = orientation.baseAreaMm2;
             piece.extentsMm = orientation.extentsMm;
             transformInPlace(mesh, orientation.transformMm);
             piece.mesh = std::move(mesh);
         }
     });
     context.throwIfCancelled();
+    size_t offCutFace = 0;
+    for (size_t p = 0; p < pieceCount; ++p) {
+        if (orientationNotes[p].empty()) continue;
+        ++offCutFace;
+        context.debug("piece " + std::to_string(p) + ": " + orientationNotes[p]);
+    }
+    if (offCutFace > 0)
+        context.info(std::to_string(offCutFace) + " of " + std::to_string(pieceCount) +
+                     " pieces have no cut face they can lie on; they rest on their largest base that fits");
     out.seconds = clock.seconds();
     context.debug("meshed, checked and oriented: " + number(out.seconds, 3) + " s");
     return out;

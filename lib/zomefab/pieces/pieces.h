@@ -86,6 +86,10 @@ struct Piece {
     Transform4d gridToPrintMm;        ///< shell-grid mm → printer mm (a rotation and a translation)
     bool isCutFaceDown = false;       ///< a planar cut face lies on the bed
     Vec3d downNormalGridMm{0, 0, -1}; ///< the outward normal (grid mm) that points down when printed
+    /// Area of the piece's cross-section kBaseHeightMm (0.2 mm) above the bed: what the first
+    /// layer prints. A cut face down gives its area; a piece with none rests on the largest base
+    /// that fits (docs/pieces.md, "Orientation").
+    double baseAreaMm2 = 0.0;
     Vec3d extentsMm{0, 0, 0};         ///< size of the printed piece along the printer's x, y, z
     double volumeMm3 = 0.0;           ///< of the mesh
     Box3d gridBoundsMm;               ///< of the mesh in the shell grid's mm

@@ -116,6 +116,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                            {{"transform_mm", matrix(p.gridToPrintMm)},
                             {"cut_face_down", p.isCutFaceDown},
                             {"down_normal", vec(p.downNormalGridMm)},
+                            {"base_area_mm2", p.baseAreaMm2},
                             {"extents_mm", vec(p.extentsMm)},
                             {"fits", true}}},
                           {"cells", p.cells},
