@@ -300,7 +300,7 @@ struct BatchCommand {
 struct BenchCommand {
     std::string output = "-";
     std::vector<std::string> meshes{"bunny_cgal_75k.stl"};
-    std::vector<double> heightsMm{200, 400, 800};
+    std::vector<double> heightsMm{300, 400, 800};
     std::string up = "y";
     std::string dataDir = "data";
     std::vector<std::string> extra;
