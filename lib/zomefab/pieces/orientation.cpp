@@ -122,14 +122,19 @@ struct MeshD {
     }
 };
 
+/// The smallest coordinate of the mesh's points along @p up, mm.
+double lowestAlong(const MeshD& m, const Vec3d& up) {
+    double lowest = 1e300;
+    for (const Vec3d& p : m.points) lowest = std::min(lowest, dot(up, p));
+    return lowest;
+}
+
 /// Cross-section area of the closed mesh at @p h above its lowest point along @p down. The solid
 /// below the section is closed by the section itself, so the section's area is minus the flux of
 /// "up" through the part of the mesh below it: the triangles there, clipped at the section.
 double sectionArea(const MeshD& m, const Vec3d& down, double h) {
     const Vec3d up = scale(down, -1.0);
-    double lowest = 1e300;
-    for (const Vec3d& p : m.points) lowest = std::min(lowest, dot(up, p));
-    const double top = lowest + h;
+    const double top = lowestAlong(m, up) + h;
     double flux = 0.0;
     for (size_t i = 0; i < m.triangles.size(); ++i) {
         const Triangle& t = m.triangles[i];
@@ -162,8 +167,7 @@ double sectionArea(const MeshD& m, const Vec3d& down, double h) {
 /// flat side tilts, so the search below settles on flat sides. mm².
 double contactMm2(const MeshD& m, const Vec3d& down, double h) {
     const Vec3d up = scale(down, -1.0);
-    double lowest = 1e300;
-    for (const Vec3d& p : m.points) lowest = std::min(lowest, dot(up, p));
+    const double lowest = lowestAlong(m, up);
     const double top = lowest + h;
     double sum = 0.0;
     for (size_t i = 0; i < m.triangles.size(); ++i) {
