@@ -74,7 +74,7 @@ struct RunCommand {
         scale.addTo(run);
         tool.addFormatOption("--in-format", inFormat, {"stl", "obj", "ply", "gltf", "glb"}, "Input format (for -)");
         run.add_flag("--repair", options.validate.repair, "Close small holes of an open mesh");
-        run.add_option("--voxel-mm", options.field.voxelMm, "Voxel of the object and shell level sets")
+        run.add_option("--voxel-mm", options.field.voxelMm, "Voxel of the object and shell level sets (at most 1.54 for the tenon pegs)")
             ->capture_default_str();
         run.add_option("--shell-mm", options.shell.shellMm, "Shell wall thickness (paper: dMin = 16 mm)")
             ->capture_default_str();

@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <set>
 #include <string>
 
 #include "zomefab/core/error.h"
@@ -310,6 +311,17 @@ void bisectUntilFit(Context& cx, const std::vector<uint32_t>& faces, const std::
     bisectUntilFit(cx, hi, salientRegionOf, parts, depth + 1);
 }
 
+/// Length (mm) of the edge faces @p f and @p h share; 0 when they share fewer than two corners.
+double sharedEdgeMm(const TriMesh& mesh, uint32_t f, uint32_t h) {
+    const auto& tf = mesh.triangles[f];
+    const auto& th = mesh.triangles[h];
+    uint32_t shared[3];
+    int n = 0;
+    for (uint32_t v : tf)
+        if (v == th[0] || v == th[1] || v == th[2]) shared[n++] = v;
+    return n >= 2 ? std::sqrt(dist2(toD(mesh.positions[shared[0]]), toD(mesh.positions[shared[1]]))) : 0.0;
+}
+
 /// Union-find over pieces.
 struct Dsu {
     std::vector<uint32_t> parent;
@@ -389,6 +401,111 @@ std::vector<uint8_t> salientFaceFlags(const TriMesh& mesh, const std::vector<Sal
     return flags;
 }
 
+RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph, const std::vector<uint32_t>& regionOf,
+                                uint32_t regionCount, const Vec3d& printerMm, double marginMm) {
+    const size_t faceCount = graph.faceCount();
+    if (regionOf.size() != faceCount)
+        throw Error(ErrorCode::Usage, "region merge: " + std::to_string(regionOf.size()) + " region ids for " +
+                                          std::to_string(faceCount) + " faces");
+    // Per region (indexed by its union-find root): area, vertices (each once per region; a vertex on
+    // a seam appears in both, which does not change a box), and the seam length to each neighbour.
+    std::vector<double> area(regionCount, 0.0);
+    std::vector<std::vector<Vec3d>> pts(regionCount);
+    std::vector<std::map<uint32_t, double>> seam(regionCount);
+    {
+        std::vector<uint32_t> offsets, faces;
+        groupFaces(regionOf, regionCount, offsets, faces);
+        std::vector<uint32_t> stamp(meshMm.positions.size(), 0);
+        uint32_t stampValue = 0;
+        for (uint32_t r = 0; r < regionCount; ++r) {
+            const std::vector<uint32_t> members(faces.begin() + offsets[r], faces.begin() + offsets[r + 1]);
+            pts[r] = faceVertices(meshMm, members, stamp, stampValue);
+        }
+    }
+    for (uint32_t f = 0; f < faceCount; ++f) {
+        area[regionOf[f]] += graph.areasMm2[f];
+        for (uint32_t i = graph.offsets[f]; i < graph.offsets[f + 1]; ++i) {
+            const uint32_t h = graph.neighbors[i];
+            if (regionOf[h] != regionOf[f]) seam[regionOf[f]][regionOf[h]] += sharedEdgeMm(meshMm, f, h);
+        }
+    }
+    auto fits = [&](const std::vector<Vec3d>& p) {
+        return fitsTrivially(p, printerMm, marginMm) || fitInPrinter(p, printerMm, marginMm).fits;
+    };
+    Dsu dsu(regionCount);
+    std::vector<char> isRoot(regionCount, 1);
+    // Pairs (lower root, higher root) whose union was tested and does not fit. A pair is tested
+    // again only after one of its regions grew (its entries are dropped then).
+    std::set<std::pair<uint32_t, uint32_t>> isTooLarge;
+    RegionMerge out;
+    std::vector<uint32_t> order;
+    for (;;) {
+        order.clear();
+        for (uint32_t r = 0; r < regionCount; ++r)
+            if (isRoot[r]) order.push_back(r);
+        std::sort(order.begin(), order.end(),
+                  [&](uint32_t a, uint32_t b) { return area[a] != area[b] ? area[a] < area[b] : a < b; });
+        bool isMerged = false;
+        for (uint32_t r : order) {
+            std::vector<std::pair<double, uint32_t>> byLength;  // (−seam length, neighbour)
+            for (const auto& [o, len] : seam[r])
+                if (!isTooLarge.count({std::min(r, o), std::max(r, o)})) byLength.push_back({-len, o});
+            if (byLength.empty()) continue;
+            std::sort(byLength.begin(), byLength.end());
+            // The unions with every candidate neighbour are tested in parallel; the first one in
+            // seam order that fits wins, so the choice does not depend on the threads.
+            std::vector<char> isFit(byLength.size(), 0);
+            tbb::parallel_for(size_t(0), byLength.size(), [&](size_t i) {
+                std::vector<Vec3d> u(pts[r]);
+                const std::vector<Vec3d>& other = pts[byLength[i].second];
+                u.insert(u.end(), other.begin(), other.end());
+                isFit[i] = fits(u) ? 1 : 0;
+            });
+            uint32_t into = kNone;
+            for (size_t i = 0; i < byLength.size(); ++i) {
+                const uint32_t o = byLength[i].second;
+                if (isFit[i]) {
+                    into = o;
+                    break;
+                }
+                isTooLarge.insert({std::min(r, o), std::max(r, o)});
+            }
+            if (into == kNone) continue;
+            // Merge r and into; the lower id stays the root.
+            dsu.join(r, into);
+            const uint32_t root = dsu.find(r), gone = root == r ? into : r;
+            isRoot[gone] = 0;
+            area[root] += area[gone];
+            pts[root].insert(pts[root].end(), pts[gone].begin(), pts[gone].end());
+            std::vector<Vec3d>().swap(pts[gone]);
+            for (const auto& [o, len] : seam[gone]) {
+                if (o == root) continue;
+                seam[root][o] += len;
+                seam[o].erase(gone);
+                seam[o][root] += len;
+            }
+            seam[root].erase(gone);
+            seam[gone].clear();
+            for (auto it = isTooLarge.begin(); it != isTooLarge.end();)
+                it = (it->first == root || it->second == root || it->first == gone || it->second == gone)
+                         ? isTooLarge.erase(it)
+                         : std::next(it);
+            ++out.merges;
+            isMerged = true;
+            break;  // areas changed: start again from the smallest region
+        }
+        if (!isMerged) break;
+    }
+    out.groupOf.assign(regionCount, kNone);
+    std::vector<uint32_t> groupOfRoot(regionCount, kNone);
+    for (uint32_t r = 0; r < regionCount; ++r) {
+        const uint32_t root = dsu.find(r);
+        if (groupOfRoot[root] == kNone) groupOfRoot[root] = out.groupCount++;
+        out.groupOf[r] = groupOfRoot[root];
+    }
+    return out;
+}
+
 // --- the stage --------------------------------------------------------------------------------
 
 namespace {
@@ -411,6 +528,7 @@ public:
         prepareProblems();
         mRun.throwIfCancelled();
         runSchedule();
+        mergeRegions();
         cutAndMakePieces();
         mRes.secondsTotal = total.seconds();
         mRun.progress("partition", 1.0);
@@ -884,6 +1002,27 @@ private:
                           ws, double(oversized.size())));
     }
 
+    /// PartitionOptions::mergeSmallRegions (docs/partition.md §4): the regions are the connected
+    /// regions of one training class (after any bisection); merged regions keep their classes, so
+    /// the SVM still sees each as it was cut, and form one group, which makePieces turns into one
+    /// piece of several cells.
+    void mergeRegions() {
+        if (!mOpt.mergeSmallRegions) return;
+        mRun.throwIfCancelled();
+        const Stopwatch clock;
+        std::vector<uint32_t> regionOf;
+        const uint32_t regionCount = labelComponents(mGraph, mTrainClass, regionOf);
+        const RegionMerge m =
+            mergeRegionsThatFit(mMesh, mGraph, regionOf, regionCount, mOpt.printerMm, mOpt.fitMarginMm);
+        mFaceGroup.resize(mFaceCount);
+        for (uint32_t f = 0; f < mFaceCount; ++f) mFaceGroup[f] = m.groupOf[regionOf[f]];
+        mGroupCount = m.groupCount;
+        mRes.regionMerges = m.merges;
+        mRun.info(std::to_string(regionCount) + " regions, " + std::to_string(m.merges) +
+                  " merged into a neighbour they fit the printer with: " + std::to_string(m.groupCount) + " regions");
+        mRun.debug(fmt("region merge: %.3f s", clock.seconds()));
+    }
+
     Context& context() {
         if (!mContext)
             mContext = std::make_unique<Context>(
@@ -1014,7 +1153,7 @@ private:
             members[c].assign(fragFaces.begin() + fragOffsets[c], fragFaces.begin() + fragOffsets[c + 1]);
         std::vector<double> area(fragArea);
         merges = 0;
-        auto tryMerge = [&](uint32_t a, uint32_t b) {
+        auto tryMerge = [&](uint32_t a, uint32_t b, bool isCounted = true) {
             a = dsu.find(a), b = dsu.find(b);
             if (a == b) return true;
             std::vector<uint32_t> joined(members[a]);
@@ -1025,9 +1164,56 @@ private:
             members[root] = std::move(joined);
             members[other].clear();
             area[root] += area[other];
-            ++merges;
+            merges += isCounted ? 1 : 0;
             return true;
         };
+        // Merged regions (mergeSmallRegions): the fragments of one group that touch each other
+        // become one piece. A fragment belongs to the group of most of its area (cells follow the
+        // regions only approximately). Normally the whole connected set fits, as the regions' union
+        // did: one test; otherwise pairwise, in fragment order, each merge only if it fits.
+        if (!mFaceGroup.empty()) {
+            std::vector<uint32_t> fragGroup(fragCount, kNone);
+            {
+                std::vector<std::map<uint32_t, double>> groupArea(fragCount);
+                for (uint32_t f = 0; f < mFaceCount; ++f) groupArea[fragOf[f]][mFaceGroup[f]] += mGraph.areasMm2[f];
+                for (uint32_t c = 0; c < fragCount; ++c) {
+                    double best = -1.0;
+                    for (const auto& [gr, a] : groupArea[c])
+                        if (a > best) best = a, fragGroup[c] = gr;  // ties: lowest group
+                }
+            }
+            std::set<std::pair<uint32_t, uint32_t>> touching;  // fragment pairs of one group
+            for (uint32_t f = 0; f < mFaceCount; ++f)
+                for (uint32_t i = mGraph.offsets[f]; i < mGraph.offsets[f + 1]; ++i) {
+                    const uint32_t a = fragOf[f], b = fragOf[mGraph.neighbors[i]];
+                    if (a < b && fragGroup[a] == fragGroup[b]) touching.insert({a, b});
+                }
+            Dsu linked(fragCount);
+            for (const auto& [a, b] : touching) linked.join(a, b);
+            std::vector<std::vector<uint32_t>> setFaces(fragCount);
+            for (uint32_t f = 0; f < mFaceCount; ++f) setFaces[linked.find(fragOf[f])].push_back(f);
+            std::vector<uint32_t> setRoots;
+            std::vector<std::vector<uint32_t>> sets;
+            for (uint32_t c = 0; c < fragCount; ++c)
+                if (linked.find(c) == c && setFaces[c].size() > members[c].size())
+                    setRoots.push_back(c), sets.push_back(std::move(setFaces[c]));
+            const std::vector<char> setFits = fitsEach(cx, sets);  // in parallel, the same test
+            std::vector<char> isWhole(fragCount, 0);
+            for (size_t i = 0; i < setRoots.size(); ++i) isWhole[setRoots[i]] = setFits[i];
+            for (const auto& [a, b] : touching) {
+                if (isWhole[linked.find(a)]) {
+                    const uint32_t ra = dsu.find(a), rb = dsu.find(b);
+                    if (ra == rb) continue;
+                    dsu.join(ra, rb);
+                    const uint32_t root = dsu.find(ra), other = root == ra ? rb : ra;
+                    members[root].insert(members[root].end(), members[other].begin(), members[other].end());
+                    members[other].clear();
+                    area[root] += area[other];
+                } else {
+                    tryMerge(a, b, false);
+                }
+            }
+        }
         // Salient regions a cut still crosses: keep them in one piece by merging the fragments of
         // their faces and of the faces around them (where corners in another cell lie), if it fits.
         for (uint32_t r : crossed) {
@@ -1167,6 +1353,10 @@ private:
                 const uint32_t c = newClassFor(pieceFaces[p]);  // the piece's faces get one class of their own first
                 for (uint32_t f : pieceFaces[p]) mTrainClass[f] = c;
                 if (splitFaces(pieceFaces[p])) ++mRes.splits;
+                // Its parts leave their merged group (each part a group of its own), so the next
+                // round does not join them into the piece that did not fit again.
+                if (!mFaceGroup.empty())
+                    for (uint32_t f : pieceFaces[p]) mFaceGroup[f] = mGroupCount + mTrainClass[f];
             }
             mRun.info(std::to_string(tooLarge.size()) +
                       " piece(s) do not fit the printer after the planar cuts; split and retrain");
@@ -1198,6 +1388,8 @@ private:
     std::vector<uint32_t> mInitial, mClusterInitial;
     std::vector<uint32_t> mTrainClass;          ///< per face: SVM class
     std::vector<zome::BallId> mClassBall;       ///< class → ball
+    std::vector<uint32_t> mFaceGroup;           ///< per face: its merged region (empty: no merge)
+    uint32_t mGroupCount = 0;                   ///< groups of the region merge (ids above: repair parts)
     std::unique_ptr<Context> mContext;
 };
 

@@ -18,6 +18,7 @@
 
 #include "zomefab/core/run_context.h"
 #include "zomefab/core/tri_mesh.h"
+#include "zomefab/partition/face_graph.h"
 #include "zomefab/partition/linear_cells.h"
 #include "zomefab/partition/printer_fit.h"
 #include "zomefab/zome/structure.h"
@@ -59,6 +60,13 @@ struct PartitionOptions {
     /// shell's thickness behind the surface and the connectors (mm).
     double fitMarginMm = 2.0;
     int maxSweeps = 100;  ///< alpha-expansion passes per graph cut at most
+    /// true (default): after the schedule, a region is merged into a neighbour (sharing a seam)
+    /// whenever the union still fits the printer (same oriented-box test and margin), smallest
+    /// regions first, each into the neighbour with the longest shared seam, until no merge fits.
+    /// The re-cuts leave small leftover regions; each piece costs two printed cut walls per seam,
+    /// assembly effort, and small pieces rarely get tenons. The merged regions keep their own SVM
+    /// classes (cells); a piece is then made of several cells. false: one piece per region.
+    bool mergeSmallRegions = true;
 
     // --- saliency (§5.1, Eq. 4): union of the mesh's salientFaces flags and these ---------------
     std::vector<SalientSphere> salientSpheres;  ///< faces touching a sphere are salient
@@ -151,6 +159,7 @@ struct PartitionResult {
     bool isScheduleBottomedOut = false;     ///< the schedule ended without every partition fitting
     size_t splits = 0;                      ///< partitions/pieces split to fit the printer
     size_t merges = 0;                      ///< small pieces merged into a neighbour
+    size_t regionMerges = 0;                ///< regions merged after the schedule (mergeSmallRegions)
     size_t svmSamples = 0;                  ///< training samples used
     double svmAgreement = 0.0;              ///< fraction of faces whose cell matches its region
     size_t graphNodes = 0;                  ///< nodes of the first graph cut (faces or clusters;
@@ -174,6 +183,21 @@ PartitionResult partitionSurface(const TriMesh& meshMm, const zome::Structure& f
 
 /// Checks @p options on their own (before any input is read). @throw Error(Usage)
 void checkPartitionOptions(const PartitionOptions& options, const zome::ZomeScale& scale = {});
+
+/// The greedy region merge of PartitionOptions::mergeSmallRegions (docs/partition.md §4).
+struct RegionMerge {
+    std::vector<uint32_t> groupOf;  ///< per region: its group, numbered by lowest region
+    uint32_t groupCount = 0;
+    size_t merges = 0;              ///< = region count − groupCount
+};
+
+/// Repeatedly merges a region of @p regionOf (per face, < @p regionCount; regions need not be
+/// connected) into an edge-adjacent one when their union's vertices fit @p printerMm with
+/// @p marginMm (the schedule's fit test): the smallest region (by area, then id) that has a
+/// neighbour it fits with goes into the one of those with the longest shared seam (then lowest id);
+/// stops when no merge fits. Deterministic, whatever the thread count.
+RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph, const std::vector<uint32_t>& regionOf,
+                                uint32_t regionCount, const Vec3d& printerMm, double marginMm);
 
 /// Per-face flags: the mesh's salientFaces, faces within a sphere (closest point of the triangle
 /// within the radius) and the listed indices. @throw Error(Usage) for an index out of range.

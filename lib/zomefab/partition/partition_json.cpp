@@ -93,6 +93,7 @@ json partitionToJson(const PartitionResult& r, const PartitionOptions& o, const 
                    {"pieces", r.pieces.size()},
                    {"splits", r.splits},
                    {"merges", r.merges},
+                   {"region_merges", r.regionMerges},
                    {"salient_faces", std::count(r.salientFaces.begin(), r.salientFaces.end(), uint8_t(1))},
                    {"salient_regions", r.salientRegions},
                    {"salient_regions_crossed", r.salientRegionsSplit},
