@@ -34,6 +34,12 @@ private:
     std::filesystem::path mPath;
 };
 
+/// Runs @p command with `bash -o pipefail -c`; its exit code (−1 when it did not exit normally).
+int runShell(const std::string& command);
+
+/// The whole file @p path as bytes (empty when it cannot be read).
+std::string readFile(const std::string& path);
+
 /// Writes @p bytes to @p path (test fixtures only).
 void writeBytes(const std::string& path, const std::string& bytes);
 

@@ -77,22 +77,31 @@ std::vector<PieceRequest> requestPerCell(const CellModel& cells) {
     return r;
 }
 
+namespace {
+
+/// Möller–Trumbore: the ray parameter where o + t·d meets triangle @p t of @p m, if it does.
+std::optional<double> rayTriangle(const TriMesh& m, const Triangle& t, const Vec3d& o, const Vec3d& d) {
+    const Vec3d a = toD(m.positions[t[0]]), b = toD(m.positions[t[1]]), c = toD(m.positions[t[2]]);
+    const Vec3d e1 = sub(b, a), e2 = sub(c, a);
+    const Vec3d p = cross(d, e2);
+    const double det = dot(e1, p);
+    if (std::abs(det) < 1e-14) return std::nullopt;
+    const Vec3d s = sub(o, a);
+    const double u = dot(s, p) / det;
+    if (u < 0 || u > 1) return std::nullopt;
+    const Vec3d q = cross(s, e1);
+    const double v = dot(d, q) / det;
+    if (v < 0 || u + v > 1) return std::nullopt;
+    return dot(e2, q) / det;
+}
+
+}  // namespace
+
 std::optional<double> firstHit(const TriMesh& m, const Vec3d& o, const Vec3d& d) {
     std::optional<double> best;
     for (const Triangle& t : m.triangles) {
-        const Vec3d a = toD(m.positions[t[0]]), b = toD(m.positions[t[1]]), c = toD(m.positions[t[2]]);
-        const Vec3d e1 = sub(b, a), e2 = sub(c, a);
-        const Vec3d p = cross(d, e2);
-        const double det = dot(e1, p);
-        if (std::abs(det) < 1e-14) continue;
-        const Vec3d s = sub(o, a);
-        const double u = dot(s, p) / det;
-        if (u < 0 || u > 1) continue;
-        const Vec3d q = cross(s, e1);
-        const double v = dot(d, q) / det;
-        if (v < 0 || u + v > 1) continue;
-        const double tt = dot(e2, q) / det;
-        if (tt > 0 && (!best || tt < *best)) best = tt;
+        const std::optional<double> tt = rayTriangle(m, t, o, d);
+        if (tt && *tt > 0 && (!best || *tt < *best)) best = tt;
     }
     return best;
 }
@@ -101,18 +110,8 @@ bool isInsideMesh(const TriMesh& m, const Vec3d& o) {
     const Vec3d d = normalized({0.5773, 0.5801, 0.5748});
     size_t crossings = 0;
     for (const Triangle& t : m.triangles) {
-        const Vec3d a = toD(m.positions[t[0]]), b = toD(m.positions[t[1]]), c = toD(m.positions[t[2]]);
-        const Vec3d e1 = sub(b, a), e2 = sub(c, a);
-        const Vec3d p = cross(d, e2);
-        const double det = dot(e1, p);
-        if (std::abs(det) < 1e-14) continue;
-        const Vec3d s = sub(o, a);
-        const double u = dot(s, p) / det;
-        if (u < 0 || u > 1) continue;
-        const Vec3d q = cross(s, e1);
-        const double v = dot(d, q) / det;
-        if (v < 0 || u + v > 1) continue;
-        if (dot(e2, q) / det > 0) ++crossings;
+        const std::optional<double> tt = rayTriangle(m, t, o, d);
+        if (tt && *tt > 0) ++crossings;
     }
     return crossings % 2 == 1;
 }

@@ -21,19 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string quoted(const std::string& s) { return "'" + s + "'"; }
-
-int run(const std::string& command) {
-    const int status = std::system(("bash -o pipefail -c " + quoted(command)).c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
-bool isInstalled(const std::string& program) { return run("command -v " + program + " > /dev/null") == 0; }
+bool isInstalled(const std::string& program) { return test::runShell("command -v " + program + " > /dev/null") == 0; }
 
 /// The inputs and one zf-pieces run, shared by the cases (the run takes a few seconds).
 struct Run {
@@ -41,7 +29,7 @@ struct Run {
     int exitCode = -1;
     Run() {
         pieces::test::writeToolInputs(dir.path().string());
-        exitCode = run(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " + dir.file("frame.json") + " " +
+        exitCode = test::runShell(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " + dir.file("frame.json") + " " +
                        dir.file("partition.json") + " -q --threads 2 -o " + dir.file("out") + " --report " +
                        dir.file("report.json"));
     }
@@ -65,7 +53,7 @@ std::string admeshField(const std::string& report, const std::string& label) {
 TEST_CASE("zf-pieces: one closed STL per piece, pieces.3mf and pieces.json") {
     const Run& r = shared();
     REQUIRE(r.exitCode == 0);
-    const nlohmann::json j = nlohmann::json::parse(slurp(r.out("pieces.json")));
+    const nlohmann::json j = nlohmann::json::parse(test::readFile(r.out("pieces.json")));
     CHECK(j["format"] == "zomefab.pieces");
     REQUIRE(j["pieces"].size() == 4);
     size_t tenons = 0;
@@ -88,8 +76,8 @@ TEST_CASE("zf-pieces: one closed STL per piece, pieces.3mf and pieces.json") {
         }
     }
     CHECK(tenons >= 4);
-    CHECK(slurp(r.out("pieces.3mf")).substr(0, 2) == "PK");
-    const nlohmann::json report = nlohmann::json::parse(slurp(r.dir.file("report.json")));
+    CHECK(test::readFile(r.out("pieces.3mf")).substr(0, 2) == "PK");
+    const nlohmann::json report = nlohmann::json::parse(test::readFile(r.dir.file("report.json")));
     CHECK(report["pieces"] == 4);
     CHECK(report["tool"] == "zf-pieces");
 }
@@ -98,13 +86,13 @@ TEST_CASE("zf-pieces: the same bytes with 1 and 2 threads") {
     const Run& r = shared();
     REQUIRE(r.exitCode == 0);
     const std::string other = r.dir.file("one-thread");
-    REQUIRE(run(test::toolPath("zf-pieces") + " " + r.dir.file("shell.vdb") + " " + r.dir.file("frame.json") + " " +
+    REQUIRE(test::runShell(test::toolPath("zf-pieces") + " " + r.dir.file("shell.vdb") + " " + r.dir.file("frame.json") + " " +
                 r.dir.file("partition.json") + " -q --threads 1 -o " + other) == 0);
     size_t files = 0;
     for (const auto& e : fs::directory_iterator(r.dir.file("out"))) {
         ++files;
         INFO(e.path().filename().string());
-        CHECK(slurp(e.path().string()) == slurp(other + "/" + e.path().filename().string()));
+        CHECK(test::readFile(e.path().string()) == test::readFile(other + "/" + e.path().filename().string()));
     }
     CHECK(files == 6);  // 4 STL, 3MF, JSON
 }
@@ -119,8 +107,8 @@ TEST_CASE("zf-pieces: admesh loads every piece with no errors and nothing to rep
     for (int i = 0; i < 4; ++i) {
         const std::string file = r.out("piece-0" + std::to_string(i) + ".stl");
         const std::string log = r.dir.file("admesh.txt");
-        REQUIRE(run("admesh " + file + " > " + log + " 2>&1") == 0);
-        const std::string report = slurp(log);
+        REQUIRE(test::runShell("admesh " + file + " > " + log + " 2>&1") == 0);
+        const std::string report = test::readFile(log);
         INFO(file << "\n" << report);
         CHECK(admeshField(report, "Total disconnected facets") == "0                   0");
         for (const char* field : {"Degenerate facets", "Edges fixed", "Facets removed", "Facets added", "Facets reversed",
@@ -140,16 +128,16 @@ TEST_CASE("zf-pieces: PrusaSlicer slices a piece and loads the 3MF") {
     // The printer's own 200 mm bed: PrusaSlicer refuses parts that do not fit it
     // (../shared/docs/print-estimates.md). Coarse layers keep this quick.
     const std::string gcode = r.dir.file("piece.gcode");
-    const int code = run("prusa-slicer --loglevel 1 --export-gcode --layer-height 0.3 --first-layer-height 0.3 "
+    const int code = test::runShell("prusa-slicer --loglevel 1 --export-gcode --layer-height 0.3 --first-layer-height 0.3 "
                          "--nozzle-diameter 0.4 --filament-diameter 2.85 --fill-density 10% --perimeters 2 "
                          "--gcode-flavor marlin2 --bed-shape 0x0,200x0,200x200,0x200 --max-print-height 200 -o " +
                          gcode + " " + r.out("piece-00.stl") + " > " + r.dir.file("slicer.txt") + " 2>&1");
-    INFO(slurp(r.dir.file("slicer.txt")));
+    INFO(test::readFile(r.dir.file("slicer.txt")));
     CHECK(code == 0);
-    CHECK(slurp(gcode).find("; estimated printing time") != std::string::npos);
+    CHECK(test::readFile(gcode).find("; estimated printing time") != std::string::npos);
 
-    REQUIRE(run("prusa-slicer --loglevel 1 --info " + r.out("pieces.3mf") + " > " + r.dir.file("info.txt") + " 2>&1") == 0);
-    const std::string info = slurp(r.dir.file("info.txt"));
+    REQUIRE(test::runShell("prusa-slicer --loglevel 1 --info " + r.out("pieces.3mf") + " > " + r.dir.file("info.txt") + " 2>&1") == 0);
+    const std::string info = test::readFile(r.dir.file("info.txt"));
     INFO(info);
     size_t manifold = 0;
     for (size_t at = info.find("manifold = yes"); at != std::string::npos; at = info.find("manifold = yes", at + 1))
@@ -166,16 +154,16 @@ TEST_CASE("zf-pieces: the real chain zf-sdf, zf-shell, zf-frame, zf-partition, z
         }
     test::ScratchDir dir("zomefab-pieces-chain");
     const std::string bunny = test::dataPath("bunny_npm_3674.stl");
-    REQUIRE(run(test::toolPath("zf-sdf") + " " + bunny + " --height-mm 250 --up y --shell-depth-mm 10 -q -o " +
+    REQUIRE(test::runShell(test::toolPath("zf-sdf") + " " + bunny + " --height-mm 250 --up y --shell-depth-mm 10 -q -o " +
                 dir.file("bunny.vdb")) == 0);
-    REQUIRE(run(test::toolPath("zf-shell") + " " + dir.file("bunny.vdb") + " --shell-mm 10 -q -o " + dir.file("shell.vdb")) == 0);
-    REQUIRE(run(test::toolPath("zf-frame") + " " + dir.file("bunny.vdb") + " --d-min-mm 10 -q -o " + dir.file("frame.json")) == 0);
-    REQUIRE(run(test::toolPath("zf-partition") + " " + bunny + " " + dir.file("frame.json") + " -q -o " +
+    REQUIRE(test::runShell(test::toolPath("zf-shell") + " " + dir.file("bunny.vdb") + " --shell-mm 10 -q -o " + dir.file("shell.vdb")) == 0);
+    REQUIRE(test::runShell(test::toolPath("zf-frame") + " " + dir.file("bunny.vdb") + " --d-min-mm 10 -q -o " + dir.file("frame.json")) == 0);
+    REQUIRE(test::runShell(test::toolPath("zf-partition") + " " + bunny + " " + dir.file("frame.json") + " -q -o " +
                 dir.file("partition.json")) == 0);
-    REQUIRE(run(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " + dir.file("frame.json") + " " +
+    REQUIRE(test::runShell(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " + dir.file("frame.json") + " " +
                 dir.file("partition.json") + " -q -o " + dir.file("out")) == 0);
-    const nlohmann::json j = nlohmann::json::parse(slurp(dir.file("out/pieces.json")));
-    const nlohmann::json partition = nlohmann::json::parse(slurp(dir.file("partition.json")));
+    const nlohmann::json j = nlohmann::json::parse(test::readFile(dir.file("out/pieces.json")));
+    const nlohmann::json partition = nlohmann::json::parse(test::readFile(dir.file("partition.json")));
     REQUIRE(j["pieces"].size() >= 2);
     CHECK(j["pieces"].size() <= partition["pieces"].size());
     double volume = 0;

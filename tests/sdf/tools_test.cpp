@@ -16,18 +16,6 @@ using namespace zomefab;
 
 namespace {
 
-std::string quoted(const std::string& s) { return "'" + s + "'"; }
-
-int run(const std::string& command) {
-    const int status = std::system(("bash -o pipefail -c " + quoted(command)).c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
 const std::string kBunny = test::dataPath("bunny_npm_3674.stl");
 const std::string kScale = " --height-mm 150 --up y --shell-depth-mm 8 -q";
 
@@ -38,13 +26,13 @@ TEST_CASE("tools: zf-sdf | zf-shell | zf-mesh through pipes gives the closed she
     const std::string sdf = test::toolPath("zf-sdf"), shell = test::toolPath("zf-shell"),
                       mesh = test::toolPath("zf-mesh");
     const std::string piped = dir.file("piped.stl");
-    REQUIRE(run(sdf + " " + kBunny + kScale + " -o - | " + shell + " - --shell-mm 8 -q -o - | " + mesh +
+    REQUIRE(test::runShell(sdf + " " + kBunny + kScale + " -o - | " + shell + " - --shell-mm 8 -q -o - | " + mesh +
                 " - -q -o " + piped) == 0);
     // The same through files.
-    REQUIRE(run(sdf + " " + kBunny + kScale + " -o " + dir.file("object.vdb")) == 0);
-    REQUIRE(run(shell + " " + dir.file("object.vdb") + " --shell-mm 8 -q -o " + dir.file("shell.vdb")) == 0);
-    REQUIRE(run(mesh + " " + dir.file("shell.vdb") + " -q -o " + dir.file("files.stl")) == 0);
-    CHECK(slurp(piped) == slurp(dir.file("files.stl")));
+    REQUIRE(test::runShell(sdf + " " + kBunny + kScale + " -o " + dir.file("object.vdb")) == 0);
+    REQUIRE(test::runShell(shell + " " + dir.file("object.vdb") + " --shell-mm 8 -q -o " + dir.file("shell.vdb")) == 0);
+    REQUIRE(test::runShell(mesh + " " + dir.file("shell.vdb") + " -q -o " + dir.file("files.stl")) == 0);
+    CHECK(test::readFile(piped) == test::readFile(dir.file("files.stl")));
 
     const TriMesh result = readMesh(piped);
     const test::EdgeReport edges = test::edgeReport(result);
@@ -54,13 +42,13 @@ TEST_CASE("tools: zf-sdf | zf-shell | zf-mesh through pipes gives the closed she
     CHECK(test::signedVolume(result) > 0);
 
     // The grids carry where they came from.
-    const auto grids = sdf::parseVdb(slurp(dir.file("shell.vdb")), "shell.vdb", RunContext::silent());
+    const auto grids = sdf::parseVdb(test::readFile(dir.file("shell.vdb")), "shell.vdb", RunContext::silent());
     REQUIRE(grids.size() == 1);
     CHECK(grids[0].info().name == "shell");
     CHECK(grids[0].info().shellMm == 8.0);
     CHECK(grids[0].info().sourceFile == kBunny);
     CHECK(grids[0].info().transformMm.at(0, 0) != 1.0);  // scaled
-    const auto objects = sdf::parseVdb(slurp(dir.file("object.vdb")), "object.vdb", RunContext::silent());
+    const auto objects = sdf::parseVdb(test::readFile(dir.file("object.vdb")), "object.vdb", RunContext::silent());
     REQUIRE(objects.size() == 2);
     CHECK(objects[1].info().name == "interior");
 }
@@ -70,11 +58,11 @@ TEST_CASE("tools: the same input gives the same .vdb and mesh bytes with 1 or 2 
     const std::string sdf = test::toolPath("zf-sdf"), mesh = test::toolPath("zf-mesh");
     for (const char* threads : {"1", "2"}) {
         const std::string object = dir.file(std::string("object") + threads + ".vdb");
-        REQUIRE(run(sdf + " " + kBunny + kScale + " --threads " + threads + " -o " + object) == 0);
-        REQUIRE(run(mesh + " " + object + " --grid object -q --threads " + threads + " -o " +
+        REQUIRE(test::runShell(sdf + " " + kBunny + kScale + " --threads " + threads + " -o " + object) == 0);
+        REQUIRE(test::runShell(mesh + " " + object + " --grid object -q --threads " + threads + " -o " +
                     dir.file(std::string("object") + threads + ".stl")) == 0);
     }
-    CHECK(slurp(dir.file("object1.vdb")).size() > 1000);
-    CHECK(slurp(dir.file("object1.vdb")) == slurp(dir.file("object2.vdb")));
-    CHECK(slurp(dir.file("object1.stl")) == slurp(dir.file("object2.stl")));
+    CHECK(test::readFile(dir.file("object1.vdb")).size() > 1000);
+    CHECK(test::readFile(dir.file("object1.vdb")) == test::readFile(dir.file("object2.vdb")));
+    CHECK(test::readFile(dir.file("object1.stl")) == test::readFile(dir.file("object2.stl")));
 }

@@ -130,14 +130,7 @@ std::vector<std::vector<SurfaceSpot>> innerSurfaceSpots(const zome::Structure& f
             const Vec3d p = madd(center, 0.5 * (lo + hi), u);
             const int64_t piece = probe.pieceAt(madd(p, 0.5 * probe.voxelMm, u));
             if (piece < 0 || size_t(piece) >= pieceCount) continue;
-            const double h = 0.5 * probe.voxelMm;
-            Vec3d g;
-            for (int k = 0; k < 3; ++k) {
-                Vec3d e{0, 0, 0};
-                e[size_t(k)] = h;
-                g[size_t(k)] = probe.signedDistanceMm(add(p, e)) - probe.signedDistanceMm(sub(p, e));
-            }
-            const Vec3d n = normalized(g);
+            const Vec3d n = probe.normalAt(p);
             if (-dot(n, u) < 0.5) continue;  // grazing: more than 60° off the surface normal
             spots[size_t(piece)].push_back({p, n});
         }

@@ -15,6 +15,17 @@ namespace zomefab::pieces {
 
 using namespace detail;
 
+Vec3d ShellProbe::normalAt(const Vec3d& p) const {
+    const double h = 0.5 * voxelMm;
+    Vec3d g;
+    for (int k = 0; k < 3; ++k) {
+        Vec3d e{0, 0, 0};
+        e[size_t(k)] = h;
+        g[size_t(k)] = signedDistanceMm(add(p, e)) - signedDistanceMm(sub(p, e));
+    }
+    return normalized(g);
+}
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -187,14 +198,7 @@ std::vector<TenonCandidate> findTenonCandidates(const zome::Structure& frame, co
             }
             // The inner surface's normal (out of the wall, into the cavity) by central differences.
             const Vec3d p = t.pointAt(hit);
-            const double h = 0.5 * voxel;
-            Vec3d g;
-            for (int k = 0; k < 3; ++k) {
-                Vec3d e{0, 0, 0};
-                e[size_t(k)] = h;
-                g[size_t(k)] = probe.signedDistanceMm(add(p, e)) - probe.signedDistanceMm(sub(p, e));
-            }
-            const Vec3d n = normalized(g);
+            const Vec3d n = probe.normalAt(p);
             const double cosTilt = std::clamp(-dot(u, n), -1.0, 1.0);
             t.tiltDeg = std::acos(cosTilt) * 180.0 / kPi;
             if (!(t.tiltDeg <= o.maxTiltDeg)) {

@@ -90,6 +90,10 @@ struct ShellProbe {
     /// farther out. Callers ask φ first: only points with φ < 0 are in the piece's material.
     std::function<int64_t(const Vec3d&)> pieceAt;
     double voxelMm = 1.0;
+
+    /// Unit normal of the shell's level set at @p p (outward of the material: out of the wall), by
+    /// central differences half a voxel apart.
+    Vec3d normalAt(const Vec3d& p) const;
 };
 
 /// One ray from a ball along a lattice hole: the tenon it would be, and why not (empty = usable).
