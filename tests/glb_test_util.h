@@ -6,7 +6,6 @@
 #pragma once
 
 #include <doctest/doctest.h>
-#include <sys/wait.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -15,6 +14,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+
+#include "test_util.h"
 
 namespace zomefab::test {
 
@@ -70,17 +71,12 @@ inline std::string nodePrefix() {
 
 /// Runs the Khronos validator on @p path; returns its JSON summary (errors, warnings, messages).
 inline nlohmann::json khronosValidate(const std::string& path) {
-    const std::string cmd =
-        "node '" + std::string(ZOMEFAB_VALIDATOR_SCRIPT) + "' '" + nodePrefix() + "' '" + path + "' 2>&1";
-    FILE* pipe = ::popen(cmd.c_str(), "r");
-    REQUIRE(pipe != nullptr);
     std::string out;
-    char buf[4096];
-    while (size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-    const int status = ::pclose(pipe);
+    const int code = runCapture(
+        "node '" + std::string(ZOMEFAB_VALIDATOR_SCRIPT) + "' '" + nodePrefix() + "' '" + path + "' 2>&1", &out);
     INFO("validator output: " << out);
-    REQUIRE(WIFEXITED(status));
-    REQUIRE(WEXITSTATUS(status) != 2);  // 2 = validator missing: run `make test-deps`
+    REQUIRE(code >= 0);
+    REQUIRE(code != 2);  // 2 = validator missing: run `make test-deps`
     return nlohmann::json::parse(out);
 }
 #endif

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
@@ -35,6 +36,17 @@ int runShell(const std::string& command) {
     for (char c : command) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
     quoted += "'";
     const int status = std::system(("bash -o pipefail -c " + quoted).c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+int runCapture(const std::string& command, std::string* out) {
+    FILE* pipe = ::popen(command.c_str(), "r");
+    if (!pipe) return -1;
+    std::string text;
+    char buf[65536];
+    while (size_t n = std::fread(buf, 1, sizeof buf, pipe)) text.append(buf, n);
+    const int status = ::pclose(pipe);
+    if (out) *out = std::move(text);
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 

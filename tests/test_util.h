@@ -37,6 +37,10 @@ private:
 /// Runs @p command with `bash -o pipefail -c`; its exit code (−1 when it did not exit normally).
 int runShell(const std::string& command);
 
+/// Runs @p command through the shell (popen); its exit code (−1 when it did not exit normally),
+/// with its stdout in @p out when given (add `2>&1` to the command for stderr too).
+int runCapture(const std::string& command, std::string* out = nullptr);
+
 /// The whole file @p path as bytes (empty when it cannot be read).
 std::string readFile(const std::string& path);
 

@@ -6,7 +6,6 @@
 /// against PrusaSlicer on the same pieces and baseline parts (within 15 %). The real checkers are
 /// skipped with a message when they are not installed (`make test-deps` installs them).
 #include <doctest/doctest.h>
-#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -33,22 +32,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-int run(const std::string& command) {
-    const int status = std::system(command.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-/// stdout and stderr of @p command.
-std::string capture(const std::string& command) {
-    FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-    REQUIRE(pipe != nullptr);
-    std::string out;
-    char buf[4096];
-    while (size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-    ::pclose(pipe);
-    return out;
-}
 
 /// |estimate / reference − 1|.
 double relativeError(double estimate, double reference) { return std::abs(estimate / reference - 1.0); }
@@ -95,7 +78,7 @@ TEST_CASE("long: every output of the 400 mm run is present") {
 
 TEST_CASE("long: the frame passes zf-zome check; every parts list equals the frame's struts") {
     const DemoRun& d = demo();
-    CHECK(run(test::toolPath("zf-zome") + " check " + d.file("frame.json") + " -q") == 0);
+    CHECK(test::runShell(test::toolPath("zf-zome") + " check " + d.file("frame.json") + " -q") == 0);
     const zome::Structure frame = zome::structureFromJsonText(readInputBytes(d.file("frame.json")));
     const json parts = partsJson(zome::partsList(frame));
     CHECK(partsJson(d.result.cost.parts) == parts);
@@ -115,10 +98,8 @@ TEST_CASE("long: the frame passes zf-zome check; every parts list equals the fra
     size_t strutsInGuide = 0;
     for (const report::BallStep& step : d.result.assembly.steps) strutsInGuide += step.struts.size();
     CHECK(strutsInGuide == frame.strutCount());
-    for (size_t i = 0; i < d.result.pieces.pieces.size(); ++i) {
-        const std::string file = pieces::pieceFileName(d.result.pieces, i);
-        CHECK(guide.find(file.substr(0, file.size() - 4)) != std::string::npos);
-    }
+    for (size_t i = 0; i < d.result.pieces.pieces.size(); ++i)
+        CHECK(guide.find(pieces::pieceName(d.result.pieces, i)) != std::string::npos);
 }
 
 TEST_CASE("long: pieces are closed, fit the printer, and sum to the shell's volume") {
@@ -144,7 +125,8 @@ TEST_CASE("long: pieces are closed, fit the printer, and sum to the shell's volu
         CHECK(m.bounds.min[2] == doctest::Approx(0).epsilon(1e-6));  // on the bed
         if (hasAdmesh) {
             // One part, nothing disconnected, nothing admesh had to fix.
-            const std::string a = capture("admesh '" + file + "'");
+            std::string a;
+            test::runCapture("admesh '" + file + "' 2>&1", &a);
             INFO(a);
             CHECK(std::regex_search(a, std::regex(R"(Number of parts\s*:\s*1\s)")));
             CHECK(std::regex_search(a, std::regex(R"(Total disconnected facets\s*:\s*0\s+0\s)")));
@@ -165,10 +147,8 @@ TEST_CASE("long: preview.glb passes the Khronos validator and its Draco pieces d
     const test::Glb g = test::parseGlb(readInputBytes(d.file("preview.glb")));
     std::set<std::string> names;
     for (const json& n : g.json["nodes"]) names.insert(n.value("name", ""));
-    for (size_t i = 0; i < d.result.pieces.pieces.size(); ++i) {
-        const std::string file = pieces::pieceFileName(d.result.pieces, i);
-        CHECK(names.count(file.substr(0, file.size() - 4)) == 1);
-    }
+    for (size_t i = 0; i < d.result.pieces.pieces.size(); ++i)
+        CHECK(names.count(pieces::pieceName(d.result.pieces, i)) == 1);
     for (const zome::BallId id : d.result.frame.structure.ballIds()) CHECK(names.count("ball-" + std::to_string(id)) == 1);
     CHECK(g.json["scenes"][0]["extras"]["parts"] == partsJson(d.result.cost.parts));
 

@@ -3,16 +3,15 @@
 /// written by the shipped binary), pieces.json placement back into frame coordinates, stdout, the
 /// Khronos validator, determinism.
 #include <doctest/doctest.h>
-#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "glb_test_util.h"
 #include "report_fixtures.h"
 #include "test_util.h"
 #include "zomefab/core/transform.h"
@@ -24,28 +23,10 @@ using namespace zomefab::test;
 
 namespace {
 
-/// Runs @p command through the shell; returns its exit code and fills @p out with its stdout.
-int run(const std::string& command, std::string* out = nullptr) {
-    FILE* pipe = ::popen(command.c_str(), "r");
-    REQUIRE(pipe != nullptr);
-    std::string text;
-    char buf[65536];
-    while (size_t n = std::fread(buf, 1, sizeof buf, pipe)) text.append(buf, n);
-    const int status = ::pclose(pipe);
-    if (out) *out = std::move(text);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 std::string preview() { return toolPath("zf-preview"); }
 std::string cubeFrame() { return std::string(ZOMEFAB_ZOME_TEST_DATA) + "/cube.json"; }
 
-nlohmann::json glbJson(const std::string& glb) {
-    REQUIRE(glb.size() >= 20);
-    REQUIRE(glb.compare(0, 4, "glTF") == 0);
-    uint32_t jsonLength = 0;
-    std::memcpy(&jsonLength, glb.data() + 12, 4);
-    return nlohmann::json::parse(glb.substr(20, jsonLength));
-}
+nlohmann::json glbJson(const std::string& glb) { return parseGlb(glb).json; }
 
 std::set<std::string> nodeNames(const nlohmann::json& j) {
     std::set<std::string> names;
@@ -63,7 +44,7 @@ TEST_CASE("zf-preview: frame and a directory of pieces (STL and GLB)") {
     std::filesystem::copy_file(std::string(ZOMEFAB_CLI_FIXTURES) + "/tetra.glb",
                                dir.file("pieces/piece-01.glb"));
     std::string err;
-    REQUIRE(run(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces") + " -o " +
+    REQUIRE(runCapture(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces") + " -o " +
                     dir.file("p.glb") + " 2>&1",
                 &err) == 0);
     CHECK(err.find("8 balls, 12 struts, 2 pieces -> ") != std::string::npos);
@@ -81,22 +62,15 @@ TEST_CASE("zf-preview: frame and a directory of pieces (STL and GLB)") {
 
     // Deterministic, and "-o -" puts exactly the same bytes on stdout.
     std::string stdoutBytes;
-    REQUIRE(run(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces") + " -o - -q",
+    REQUIRE(runCapture(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces") + " -o - -q",
                 &stdoutBytes) == 0);
     CHECK(stdoutBytes == readInputBytes(dir.file("p.glb")));
 
-    if (run("command -v node > /dev/null 2>&1") != 0) {
+    if (!hasCommand("node")) {
         MESSAGE("node is not installed: the Khronos glTF-Validator check is skipped");
         return;
     }
-    const char* env = std::getenv("ZOMEFAB_NODE_DIR");
-    std::string summary;
-    const int code = run("node '" + std::string(ZOMEFAB_VALIDATOR_SCRIPT) + "' '" +
-                             (env ? env : ZOMEFAB_NODE_DIR) + "' '" + dir.file("p.glb") + "' 2>&1",
-                         &summary);
-    INFO("validator: " << summary);
-    REQUIRE(code != 2);  // 2 = the validator is not installed: run `make test-deps`
-    const nlohmann::json report = nlohmann::json::parse(summary);
+    const nlohmann::json report = khronosValidate(dir.file("p.glb"));
     CHECK(report["errors"] == 0);
     CHECK(report["warnings"] == 0);
 }
@@ -124,7 +98,7 @@ TEST_CASE("zf-preview: pieces.json pieces go back from the printer to the frame'
                                       {"file", "piece-00.stl"},
                                       {"orientation", {{"transform_mm", matrix(gridToPrint)}}}}}}};
     writeBytes(dir.file("pieces.json"), pieces.dump());
-    REQUIRE(run(preview() + " " + cubeFrame() + " --pieces " + dir.path().string() + " --no-draco -o " +
+    REQUIRE(runCapture(preview() + " " + cubeFrame() + " --pieces " + dir.path().string() + " --no-draco -o " +
                 dir.file("p.glb") + " -q") == 0);
     const nlohmann::json j = glbJson(readInputBytes(dir.file("p.glb")));
     CHECK(!j.contains("extensionsUsed"));
@@ -140,7 +114,7 @@ TEST_CASE("zf-preview: pieces.json pieces go back from the printer to the frame'
     writeBytes(dir.file("pieces.json"),
                R"({"format": "zomefab.pieces", "version": 1, "pieces": [{"piece": 0}]})");
     std::string err;
-    CHECK(run(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces.json") + " -o " +
+    CHECK(runCapture(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces.json") + " -o " +
                   dir.file("bad.glb") + " 2>&1",
               &err) == 2);
     CHECK(err.find("pieces.json: pieces[0] has no file") != std::string::npos);

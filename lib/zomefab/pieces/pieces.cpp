@@ -389,9 +389,9 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
     const FloatGrid::ConstPtr shell = sdf::levelSetGrid(shellSet);
     const double voxel = shell->voxelSize()[0];
     PiecesOptions opt = options;
-    if (opt.tenons.maxPerPiece > 0 && voxel > 0.5 * pegShortMm(opt.tenons))
+    if (opt.tenons.maxPerPiece > 0 && voxel > maxVoxelForPegsMm(opt.tenons))
         throw Error(ErrorCode::Usage, "tenon pegs " + number(pegShortMm(opt.tenons)) + " mm thick need a voxel of at most " +
-                                          number(0.5 * pegShortMm(opt.tenons)) + " mm, but the shell's voxel is " +
+                                          number(maxVoxelForPegsMm(opt.tenons)) + " mm, but the shell's voxel is " +
                                           number(voxel) + " mm: rebuild it finer (zf-sdf --voxel-mm) or turn tenons off");
     if (opt.label.isEnabled && opt.label.strokeMm < 2.0 * voxel) {
         context.warn("piece numbers are not engraved: a " + number(opt.label.strokeMm) + " mm stroke needs a voxel of at most " +

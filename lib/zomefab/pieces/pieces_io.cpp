@@ -27,13 +27,15 @@ json matrix(const Transform4d& t) {
 
 }  // namespace
 
-std::string pieceFileName(const Pieces& pieces, size_t index) {
+std::string pieceName(const Pieces& pieces, size_t index) {
     size_t width = 2;
     for (size_t n = pieces.pieces.size(); n > 100; n /= 10) ++width;
     std::string digits = std::to_string(index);
     if (digits.size() < width) digits.insert(0, width - digits.size(), '0');
-    return "piece-" + digits + ".stl";
+    return "piece-" + digits;
 }
+
+std::string pieceFileName(const Pieces& pieces, size_t index) { return pieceName(pieces, index) + ".stl"; }
 
 json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
     const PiecesOptions& o = all.options;
@@ -147,11 +149,10 @@ void writePieces(const Pieces& all, const std::string& directory, const PiecesJs
     // The 3MF lays the pieces out on a plate of bed-sized cells, 10 mm apart, row by row.
     const size_t columns = size_t(std::ceil(std::sqrt(double(std::max<size_t>(all.pieces.size(), 1)))));
     for (size_t i = 0; i < all.pieces.size(); ++i) {
-        const std::string name = pieceFileName(all, i);
-        writeMesh(all.pieces[i].mesh, staging.file(name));
+        writeMesh(all.pieces[i].mesh, staging.file(pieceFileName(all, i)));
         const double dx = double(i % columns) * (all.printerMm[0] + 10.0);
         const double dy = double(i / columns) * (all.printerMm[1] + 10.0);
-        objects.push_back({name.substr(0, name.size() - 4), &all.pieces[i].mesh,
+        objects.push_back({pieceName(all, i), &all.pieces[i].mesh,
                            Transform4d::scaleTranslate(1.0, {dx, dy, 0.0})});
     }
     writeThreeMf(objects, generatorString(), staging.file("pieces.3mf"));

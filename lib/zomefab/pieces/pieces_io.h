@@ -21,7 +21,10 @@ struct PiecesJsonInfo {
     std::string partitionFile;
 };
 
-/// "piece-07.stl": two digits at least, more when there are over 100 pieces.
+/// "piece-07": the piece's name in files, the preview and the assembly guide; two digits at least,
+/// more when there are over 100 pieces.
+std::string pieceName(const Pieces& pieces, size_t index);
+/// "piece-07.stl".
 std::string pieceFileName(const Pieces& pieces, size_t index);
 
 /// The pieces.json document: no timings, so equal inputs give equal bytes.

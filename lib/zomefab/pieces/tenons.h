@@ -48,6 +48,8 @@ void checkTenonOptions(const TenonOptions& options);
 /// The peg's section: the hole less the clearance on every side.
 inline double pegLongMm(const TenonOptions& o) { return o.holeLongMm - 2 * o.clearanceMm; }
 inline double pegShortMm(const TenonOptions& o) { return o.holeShortMm - 2 * o.clearanceMm; }
+/// Coarsest shell voxel that still resolves the pegs: two voxels across their short side.
+inline double maxVoxelForPegsMm(const TenonOptions& o) { return 0.5 * pegShortMm(o); }
 /// Radius of the capsule around the prism that the collision tests use (its half-diagonal).
 double bodyRadiusMm(const TenonOptions& o);
 

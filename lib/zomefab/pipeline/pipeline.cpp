@@ -35,12 +35,6 @@ auto timedStage(const std::string& name, RunResult& result, RunContext& context,
     return value;
 }
 
-/// "piece-07": the piece's file name without ".stl", as node and guide name.
-std::string pieceName(const pieces::Pieces& all, size_t index) {
-    const std::string file = pieces::pieceFileName(all, index);
-    return file.substr(0, file.size() - 4);
-}
-
 std::string format(const char* pattern, double a, double b = 0, double c = 0, double d = 0) {
     char text[256];
     std::snprintf(text, sizeof text, pattern, a, b, c, d);
@@ -70,17 +64,12 @@ void checkRunOptions(const RunOptions& options) {
     pieces::checkPiecesOptions(options.pieces);
     if (options.frame.chains < 1) throw Error(ErrorCode::Usage, "--chains must be at least 1");
     // The pieces stage would find this out only after the level sets; say it before any work.
-    const double maxVoxelMm = 0.5 * pieces::pegShortMm(options.pieces.tenons);
+    const double maxVoxelMm = pieces::maxVoxelForPegsMm(options.pieces.tenons);
     if (options.pieces.tenons.maxPerPiece > 0 && options.field.voxelMm > maxVoxelMm)
         throw Error(ErrorCode::Usage, "--voxel-mm " + format("%g", options.field.voxelMm) + ": the tenon pegs (" +
                                           format("%.2f", pieces::pegShortMm(options.pieces.tenons)) +
                                           " mm thick) need a voxel of at most " + format("%.2f", maxVoxelMm) + " mm");
-    options.cost.print.validate();
-    options.cost.filament.validate();
-    if (options.cost.source == report::EstimateSource::PrusaSlicer &&
-        !report::isSlicerAvailable(options.cost.slicer.executable))
-        throw Error(ErrorCode::Usage, "--slicer " + options.cost.slicer.executable +
-                                          ": not installed or not executable (Debian package prusa-slicer)");
+    report::checkCostOptions(options.cost);
 }
 
 RunResult runPipeline(const TriMesh& input, const std::string& sourceName, const RunOptions& options,
@@ -172,7 +161,7 @@ RunResult runPipeline(const TriMesh& input, const std::string& sourceName, const
         std::vector<TriMesh> printed;
         for (size_t i = 0; i < result.pieces.pieces.size(); ++i) {
             const pieces::Piece& piece = result.pieces.pieces[i];
-            names.push_back(pieceName(result.pieces, i));
+            names.push_back(pieces::pieceName(result.pieces, i));
             for (const pieces::Tenon& tenon : piece.tenons) links.push_back({names.back(), tenon.ball, tenon.hole});
             printed.push_back(piece.mesh);
         }
@@ -194,7 +183,7 @@ report::PreviewInput previewInput(const RunResult& result) {
     for (size_t i = 0; i < result.pieces.pieces.size(); ++i) {
         const pieces::Piece& piece = result.pieces.pieces[i];
         input.pieces.push_back(piece.mesh);
-        input.pieceNames.push_back(pieceName(result.pieces, i));
+        input.pieceNames.push_back(pieces::pieceName(result.pieces, i));
         input.pieceTransforms.push_back(gridToFrameMm * affineInverse(piece.gridToPrintMm));
     }
     input.frame = &result.frame.structure;

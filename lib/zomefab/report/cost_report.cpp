@@ -56,8 +56,7 @@ const char* estimateSourceName(EstimateSource source) {
     return source == EstimateSource::PrusaSlicer ? "prusa-slicer" : "estimator";
 }
 
-CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piecesMm,
-                      const zome::PartsList& parts, const CostOptions& options, RunContext& context) {
+void checkCostOptions(const CostOptions& options) {
     options.print.validate();
     options.filament.validate();
     if (!(options.assembly.secondsPerStrut >= 0.0) || !(options.assembly.secondsPerBall >= 0.0))
@@ -65,6 +64,11 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piece
     if (options.source == EstimateSource::PrusaSlicer && !isSlicerAvailable(options.slicer.executable))
         throw Error(ErrorCode::Usage, "--slicer " + options.slicer.executable +
                                           ": not installed or not executable (Debian package prusa-slicer)");
+}
+
+CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piecesMm,
+                      const zome::PartsList& parts, const CostOptions& options, RunContext& context) {
+    checkCostOptions(options);
     CostReport report;
     report.options = options;
     report.source = options.source;

@@ -82,6 +82,11 @@ struct CostReport {
     CostOptions options;  ///< the options used, echoed into the JSON
 };
 
+/// @throw Error(Usage) naming the option for invalid print, filament or assembly options, or a
+/// PrusaSlicer source whose executable is not installed. costReport() calls it; callers call it
+/// before long work so a bad option fails fast.
+void checkCostOptions(const CostOptions& options);
+
 /// Builds the report. @p objectMm is the closed input object in mm as it would be printed whole
 /// (z up); @p piecesMm the closed pieces as they will be printed (print orientation); @p parts the
 /// frame's parts list. With EstimateSource::PrusaSlicer every piece and baseline part is sliced
