@@ -144,6 +144,8 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--tenon-max-tilt-deg", opt.tenons.maxTiltDeg, "Largest angle between hole axis and surface normal")
         ->capture_default_str();
+    app.add_flag("--tenon-lattice-holes-only", opt.tenons.latticeHolesOnly,
+                 "Tenons only along the lattice axes (+-x +-y +-z), as the paper; default: all 30 blue holes");
     app.add_flag("--no-label", isUnlabelled, "Do not engrave piece numbers");
     app.add_option("--label-height-mm", opt.label.heightMm, "Height of the engraved digits")->capture_default_str();
     app.add_option("--label-depth-mm", opt.label.depthMm, "Engraving depth")->capture_default_str();

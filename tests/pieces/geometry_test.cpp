@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <set>
 
 #include "test_util.h"
 #include "zomefab/core/error.h"
@@ -110,16 +111,6 @@ TEST_CASE("transform: affineInverse undoes a rotation, scale and translation") {
     CHECK_THROWS_AS(affineInverse(singular), Error);
 }
 
-TEST_CASE("tenons: the peg's long side follows the blue hole's golden rectangle") {
-    // +z hole: long side along x; +x: along y; +y: along z (zome-geometry.md §2); − holes alike.
-    CHECK(pegLongSideFrame(2) == Vec3d{1, 0, 0});
-    CHECK(pegLongSideFrame(0) == Vec3d{0, 1, 0});
-    CHECK(pegLongSideFrame(1) == Vec3d{0, 0, 1});
-    CHECK(pegLongSideFrame(17) == Vec3d{1, 0, 0});
-    CHECK(pegLongSideFrame(15) == Vec3d{0, 1, 0});
-    for (int hole : {0, 1, 2, 15, 16, 17}) CHECK(dot(pegLongSideFrame(hole), zome::holeDirection(hole)) == 0.0);
-}
-
 TEST_CASE("tenons: signed distance of the prism and the peg") {
     TenonOptions o;
     Tenon t;
@@ -176,6 +167,7 @@ TEST_CASE("tenons: options out of range are usage errors") {
 TEST_CASE("tenons: rays from one ball in a spherical shell") {
     const zome::Structure frame = oneBall();
     TenonOptions o;
+    o.latticeHolesOnly = true;  // the paper's six
     const double inner = 30.0;
     const auto candidates = findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0, 5.0), o);
     REQUIRE(candidates.size() == 6);
@@ -190,6 +182,33 @@ TEST_CASE("tenons: rays from one ball in a spherical shell") {
         // Up (+z) meets piece 0, the rest piece 1 (the cut is at z = 5).
         CHECK(c.piece == (c.tenon.hole == 2 ? 0 : 1));
     }
+    // All 30 blue holes (the default): the six above plus 24 more. Each accepted one reaches the wall
+    // straight on, in the piece its axis meets, with the peg's long side along the hole's rectangle;
+    // the others are rays whose prism the cut at z = 5 runs through.
+    TenonOptions allBlue;
+    const auto all = findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0, 5.0), allBlue);
+    REQUIRE(all.size() == 30);
+    std::set<int> holes;
+    int accepted = 0;
+    for (const TenonCandidate& c : all) {
+        INFO("hole " << c.tenon.hole);
+        holes.insert(c.tenon.hole);
+        CHECK(zome::holeColor(c.tenon.hole) == zome::Color::Blue);
+        const double hitZ = inner * c.tenon.axisGrid[2];
+        if (!c.rejection.empty()) {
+            CHECK((c.rejection == "crosses another piece" || c.rejection == "too close to the piece's edge"));
+            CHECK(std::abs(hitZ - 5.0) < bodyRadiusMm(o) + 1.0);
+            continue;
+        }
+        ++accepted;
+        CHECK(c.tenon.baseMm == doctest::Approx(inner).epsilon(1e-6));
+        CHECK(c.tenon.tiltDeg < 1.0);
+        CHECK(c.piece == (hitZ > 5.0 ? 0 : 1));
+        const Vec3d& side = zome::holeSectionAxis(c.tenon.hole);
+        for (int k = 0; k < 3; ++k) CHECK(c.tenon.longSideGrid[size_t(k)] == doctest::Approx(side[size_t(k)]));
+    }
+    CHECK(holes.size() == 30);
+    CHECK(accepted >= 24);
     // Too far: a 15 mm limit (the rays look twice as far, so the wall 21 mm away is seen).
     TenonOptions shortOnes = o;
     shortOnes.maxLengthMm = 15;
@@ -282,7 +301,7 @@ TEST_CASE("tenons: the choice gives every piece its share, prefers one direction
     CHECK(plan.shortfall[1].at("another tenon in the way") == 1);
     CHECK(plan.shortfall[1].at("surface too oblique") == 1);
     CHECK(plan.perPiece[2].empty());
-    CHECK(plan.shortfall[2].count("no lattice axis of a ball meets this piece") == 1);
+    CHECK(plan.shortfall[2].count("no blue hole of a ball points at this piece") == 1);
     // No two chosen prisms come closer than twice their radius.
     std::vector<Tenon> all;
     for (const auto& list : plan.perPiece) all.insert(all.end(), list.begin(), list.end());
@@ -308,11 +327,13 @@ TEST_CASE("tenons: a rotated frame rotates the axes and the peg") {
     centred.signedDistanceMm = [&](const Vec3d& x) { return probe.signedDistanceMm(sub(x, {5, -3, 2})); };
     centred.pieceAt = [&](const Vec3d& x) { return probe.pieceAt(sub(x, {5, -3, 2})); };
     TenonOptions o;
-    for (const TenonCandidate& cand : findTenonCandidates(oneBall(), rot, centred, o)) {
+    const auto candidates = findTenonCandidates(oneBall(), rot, centred, o);
+    CHECK(candidates.size() == 30);
+    for (const TenonCandidate& cand : candidates) {
         CHECK(cand.rejection.empty());
         const Vec3d expected = applyLinear(rot, zome::holeDirection(cand.tenon.hole));
         for (int a = 0; a < 3; ++a) CHECK(cand.tenon.axisGrid[size_t(a)] == doctest::Approx(expected[size_t(a)]));
-        const Vec3d longSide = applyLinear(rot, pegLongSideFrame(cand.tenon.hole));
+        const Vec3d longSide = applyLinear(rot, zome::holeSectionAxis(cand.tenon.hole));
         for (int a = 0; a < 3; ++a) CHECK(cand.tenon.longSideGrid[size_t(a)] == doctest::Approx(longSide[size_t(a)]));
         CHECK(cand.tenon.baseMm == doctest::Approx(30).epsilon(1e-6));
     }

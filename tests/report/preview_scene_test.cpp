@@ -73,29 +73,6 @@ TEST_CASE("preview_scene: strut cross-sections have the Zome model's sizes") {
     for (const auto& s : {blue, yellow, red}) CHECK(polygonArea(s) > 0.0);  // counter-clockwise
 }
 
-TEST_CASE("preview_scene: cross-section frames follow the ball's holes") {
-    // docs/zome.md §2: the +z blue hole has its long side along x, +x along y, +y along z.
-    const Vec3d z = strutCrossSectionFrame(2), x = strutCrossSectionFrame(0), y = strutCrossSectionFrame(1);
-    CHECK(std::abs(z[0]) == doctest::Approx(1.0));
-    CHECK(std::abs(x[1]) == doctest::Approx(1.0));
-    CHECK(std::abs(y[2]) == doctest::Approx(1.0));
-    for (int hole = 0; hole < zome::kHoleCount; ++hole) {
-        const Vec3d u = strutCrossSectionFrame(hole), d = zome::holeDirection(hole);
-        CHECK(u[0] * d[0] + u[1] * d[1] + u[2] * d[2] == doctest::Approx(0.0).epsilon(1e-12));
-        CHECK(u[0] * u[0] + u[1] * u[1] + u[2] * u[2] == doctest::Approx(1.0));
-    }
-    // A yellow triangle's corners point at red holes: rotating the corner by 120° about the axis
-    // gives another red direction's projection; checked via the angle to the nearest red hole.
-    const Vec3d d = zome::holeDirection(30), u = strutCrossSectionFrame(30);
-    double best = -2.0;
-    for (int h = 50; h < 62; ++h) {
-        const Vec3d& r = zome::holeDirection(h);
-        best = std::max(best, (r[0] * u[0] + r[1] * u[1] + r[2] * u[2]) /
-                                  std::sqrt(1.0 - std::pow(r[0] * d[0] + r[1] * d[1] + r[2] * d[2], 2)));
-    }
-    CHECK(best == doctest::Approx(1.0));
-}
-
 TEST_CASE("preview_scene: pieces, one instanced ball mesh, one mesh per strut kind") {
     const zome::Structure frame = colourFrame();
     PreviewInput input;
@@ -127,7 +104,7 @@ TEST_CASE("preview_scene: pieces, one instanced ball mesh, one mesh per strut ki
     CHECK(up[1] == doctest::Approx(1.0));
 
     // Every strut prism runs from ball surface to ball surface, along its hole, cross-section
-    // aligned with strutCrossSectionFrame().
+    // aligned with zome::holeSectionAxis().
     for (zome::StrutId id : frame.strutIds()) {
         const zome::Strut& s = frame.strut(id);
         const GlbNode* node = findNode(scene, "strut-" + std::to_string(id));
@@ -142,7 +119,7 @@ TEST_CASE("preview_scene: pieces, one instanced ball mesh, one mesh per strut ki
             CHECK(node->translation[size_t(k)] + tip[size_t(k)] ==
                   doctest::Approx(s.endMm[size_t(k)]).epsilon(1e-6));  // float mesh
         }
-        const Vec3d x = rotate(node->rotation, {1, 0, 0}), u = strutCrossSectionFrame(s.holeA);
+        const Vec3d x = rotate(node->rotation, {1, 0, 0}), u = zome::holeSectionAxis(s.holeA);
         CHECK(x[0] * u[0] + x[1] * u[1] + x[2] * u[2] == doctest::Approx(1.0));
         CHECK(node->extras["part"] == zome::partName(s.color, s.size));
     }

@@ -25,17 +25,9 @@ inline bool isClosedOriented(const TriMesh& m) {
 }
 
 /// @p m with bit-identical positions merged (flat-shaded meshes split vertices per face).
-inline TriMesh weldedByPosition(const TriMesh& m) {
-    TriMesh out;
-    std::map<Vec3f, uint32_t> index;
-    std::vector<uint32_t> remap(m.positions.size());
-    for (size_t v = 0; v < m.positions.size(); ++v) {
-        const auto [it, isNew] = index.emplace(m.positions[v], uint32_t(out.positions.size()));
-        if (isNew) out.positions.push_back(m.positions[v]);
-        remap[v] = it->second;
-    }
-    for (const Triangle& t : m.triangles) out.triangles.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
-    return out;
+inline TriMesh weldedByPosition(TriMesh m) {
+    weldIdenticalVertices(m);
+    return m;
 }
 
 /// A small frame with every colour: ball 0 at the origin, a B0 (hole 0, +x), a Y0 (hole 30), an

@@ -3,11 +3,13 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <random>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "zomefab/core/error.h"
 
@@ -132,6 +134,40 @@ TEST_CASE("zome system: the hole set is closed under the pyritohedral symmetries
         REQUIRE(m);
         CHECK(m->color == holeColor(h));  // symmetries preserve colours
     }
+}
+
+TEST_CASE("zome system: hole sections follow the ball's faces") {
+    auto dot3 = [](const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+    // zome-geometry.md §2: the +z blue hole has its long side along x, +x along y, +y along z.
+    CHECK(std::abs(holeSectionAxis(2)[0]) == doctest::Approx(1.0));
+    CHECK(std::abs(holeSectionAxis(0)[1]) == doctest::Approx(1.0));
+    CHECK(std::abs(holeSectionAxis(1)[2]) == doctest::Approx(1.0));
+    for (int hole = 0; hole < kHoleCount; ++hole) {
+        const Vec3d& u = holeSectionAxis(hole);
+        CHECK(dot3(u, holeDirection(hole)) == doctest::Approx(0.0).epsilon(1e-12));
+        CHECK(dot3(u, u) == doctest::Approx(1.0));
+    }
+    // Every blue hole is a 2-fold axis between two red (5-fold) neighbours at the same angle; the
+    // rectangle's long side runs from one to the other, so it is along their difference.
+    for (int hole = 0; hole < 30; ++hole) {
+        std::vector<std::pair<double, int>> reds;
+        for (int r = 50; r < 62; ++r) reds.push_back({holeCosine(hole, r), r});
+        std::sort(reds.rbegin(), reds.rend());
+        CHECK(reds[0].first == doctest::Approx(reds[1].first));
+        CHECK(reds[1].first > reds[2].first + 0.1);
+        const Vec3d &a = holeDirection(reds[0].second), &b = holeDirection(reds[1].second);
+        const Vec3d diff{a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+        CHECK(std::abs(dot3(diff, holeSectionAxis(hole))) == doctest::Approx(std::sqrt(dot3(diff, diff))));
+    }
+    // A yellow triangle's corner points at the nearest red hole: the corner direction is that red
+    // direction's projection on the face plane.
+    const Vec3d &d = holeDirection(30), &u = holeSectionAxis(30);
+    double best = -2.0;
+    for (int h = 50; h < 62; ++h) {
+        const Vec3d& r = holeDirection(h);
+        best = std::max(best, dot3(r, u) / std::sqrt(1.0 - std::pow(dot3(r, d), 2)));
+    }
+    CHECK(best == doctest::Approx(1.0));
 }
 
 TEST_CASE("zome system: the B0 cube") {

@@ -39,4 +39,8 @@ struct Box3d {
 /// Bounding box of the mesh's referenced and unreferenced vertices.
 Box3d boundingBox(const TriMesh& mesh);
 
+/// Merges vertices with bit-identical coordinates (−0 = +0) into one, in first-seen order, and
+/// renumbers the triangles. Triangles are kept as they are, including any that now repeat a vertex.
+void weldIdenticalVertices(TriMesh& mesh);
+
 }  // namespace zomefab

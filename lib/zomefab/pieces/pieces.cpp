@@ -925,6 +925,14 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
             piece.baseAreaMm2 = orientation.baseAreaMm2;
             piece.extentsMm = orientation.extentsMm;
             transformInPlace(mesh, orientation.transformMm);
+            // The adaptive mesher can emit two points a float's rounding apart (seen where a tenon
+            // off the lattice axes meets a curved wall); turned onto the bed they can round to the
+            // same point. Welded, the zero-area triangles between them repeat a vertex and go, so
+            // the STL has no degenerate facet.
+            weldIdenticalVertices(mesh);
+            mesh.triangles.erase(std::remove_if(mesh.triangles.begin(), mesh.triangles.end(),
+                                                [](const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }),
+                                 mesh.triangles.end());
             piece.mesh = std::move(mesh);
         }
     });

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Tenons (paper §6.1): candidate rays along the lattice blue holes, the collision and containment
+// Tenons (paper §6.1): candidate rays along the balls' blue holes, the collision and containment
 // tests, the greedy choice, and the tenon solid's signed distance.
 #include "zomefab/pieces/tenons.h"
 
@@ -31,6 +31,16 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 /// The lattice axes' blue holes: +x +y +z, then −x −y −z (zome_system.h numbering).
 constexpr int kLatticeHoles[6] = {0, 1, 2, 15, 16, 17};
+
+/// The holes a tenon may plug into: the six lattice ones first (the paper's), then the other 24 blue.
+std::vector<int> tenonHoles(const TenonOptions& o) {
+    std::vector<int> holes(std::begin(kLatticeHoles), std::end(kLatticeHoles));
+    if (o.latticeHolesOnly) return holes;
+    const auto [first, last] = zome::holeRange(zome::Color::Blue);
+    for (int hole = first; hole < last; ++hole)
+        if (std::find(holes.begin(), holes.end(), hole) == holes.end()) holes.push_back(hole);
+    return holes;
+}
 /// How far the peg reaches into the prism so that the union has no seam at the shoulder.
 constexpr double kPegOverlapMm = 0.5;
 
@@ -81,14 +91,6 @@ void checkTenonOptions(const TenonOptions& o) {
 }
 
 double bodyRadiusMm(const TenonOptions& o) { return o.bodyWidthMm * std::sqrt(0.5); }
-
-Vec3d pegLongSideFrame(int hole) {
-    // Lattice holes only: axis index 0, 1, 2 = x, y, z; the long side follows cyclically.
-    const int axis = hole % 15;
-    Vec3d v{0, 0, 0};
-    v[size_t((axis + 1) % 3)] = 1.0;
-    return v;
-}
 
 double tenonSignedDistanceMm(const Tenon& t, const TenonOptions& o, const Vec3d& p) {
     const Vec3d d = sub(p, t.ballCenterGridMm);
@@ -143,17 +145,18 @@ std::vector<TenonCandidate> findTenonCandidates(const zome::Structure& frame, co
     // Rays look twice as far as a tenon may reach, so "too far" is told apart from "no wall".
     const double reach = shoulder + 2.0 * o.maxLengthMm;
     const double halfWidth = 0.5 * o.bodyWidthMm;
+    const std::vector<int> holes = tenonHoles(o);
     for (zome::BallId id : frame.ballIds()) {
         const zome::Ball& ball = frame.ball(id);
         const Vec3d center = frameToGridMm.apply(ball.positionMm);
-        for (int hole : kLatticeHoles) {
+        for (int hole : holes) {
             TenonCandidate c;
             Tenon& t = c.tenon;
             t.ball = id;
             t.hole = hole;
             t.axisFrame = zome::holeDirection(hole);
             t.axisGrid = normalized(applyLinear(frameToGridMm, t.axisFrame));
-            t.longSideGrid = normalized(applyLinear(frameToGridMm, pegLongSideFrame(hole)));
+            t.longSideGrid = normalized(applyLinear(frameToGridMm, zome::holeSectionAxis(hole)));
             t.ballCenterGridMm = center;
             t.shoulderMm = shoulder;
             t.pegTipMm = shoulder - o.pegDepthMm;
@@ -307,7 +310,7 @@ TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, size_t pie
         auto& reasons = plan.shortfall[p];
         for (size_t i = 0; i < candidates.size(); ++i)
             if (candidates[i].piece == int64_t(p) && !rejection[i].empty()) ++reasons[rejection[i]];
-        if (reasons.empty()) reasons["no lattice axis of a ball meets this piece"] = 1;
+        if (reasons.empty()) reasons["no blue hole of a ball points at this piece"] = 1;
     }
     return plan;
 }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-/// @file Tenons (paper §6.1): from the frame's balls, rays along the 6 lattice blue holes (the
-/// lattice axes) find the pieces' inner surface; where it is met nearly perpendicularly, the hole
+/// @file Tenons (paper §6.1): from the frame's balls, rays along the blue holes (all 30 by default;
+/// the paper's 6 lattice axes with latticeHolesOnly) find the pieces' inner surface; where it is met
+/// nearly perpendicularly, the hole
 /// is free and nothing of the frame is in the way, a tenon is grown: a square prism from the wall
 /// to the ball's blue face, ending in a peg with the golden-rectangle section of the blue hole.
 /// No OpenVDB here: the shell is queried through ShellProbe. docs/pieces.md, "Tenons".
@@ -40,6 +41,9 @@ struct TenonOptions {
     /// surface needs to bury the whole end face.
     double embedMm = 1.5;
     double frameClearanceMm = 0.5; ///< extra gap between the prism and struts or other balls
+    /// true: only the six lattice-axis holes (±x ±y ±z), as the paper (§6.1); false: all 30 blue
+    /// holes, which reach walls the lattice axes meet too obliquely (docs/pieces.md, "Tenons").
+    bool latticeHolesOnly = false;
 };
 
 /// @throw Error(Usage) naming the option when a value is out of range.
@@ -56,11 +60,11 @@ double bodyRadiusMm(const TenonOptions& o);
 /// One tenon. Distances are along the axis from the ball's centre, in mm.
 struct Tenon {
     zome::BallId ball = zome::kNoId;
-    int hole = 0;                  ///< a lattice blue hole: 0, 1, 2 (+x +y +z) or 15, 16, 17 (−x −y −z)
+    int hole = 0;                  ///< a blue hole, 0..29 (zome_system.h numbering)
     uint32_t piece = 0;
     Vec3d axisFrame{0, 0, 1};      ///< zome::holeDirection(hole): exact, frame coordinates
     Vec3d axisGrid{0, 0, 1};       ///< the same in the grid's mm (rotated by frameToGridMm)
-    Vec3d longSideGrid{1, 0, 0};   ///< the peg's long side (grid), as the hole's golden rectangle
+    Vec3d longSideGrid{1, 0, 0};   ///< the peg's long side (grid): zome::holeSectionAxis(hole), rotated
     Vec3d ballCenterGridMm{0, 0, 0};
     double shoulderMm = 0.0;       ///< the ball's blue face, where the prism ends and the peg starts
     double baseMm = 0.0;           ///< where the axis meets the inner surface
@@ -74,10 +78,6 @@ struct Tenon {
                 ballCenterGridMm[2] + t * axisGrid[2]};
     }
 };
-
-/// The peg's long side for a lattice hole, in frame coordinates: the hole on ±z has its long side
-/// along x, on ±x along y, on ±y along z (zome-geometry.md §2).
-Vec3d pegLongSideFrame(int hole);
 
 /// Signed distance to the tenon solid (prism ∪ peg), negative inside, in the grid's mm. Exact
 /// outside each box, and where one box is nearest inside.

@@ -19,7 +19,6 @@ namespace {
 
 using Mat3 = std::array<Vec3d, 3>;  // columns
 
-Vec3d sub(const Vec3d& a, const Vec3d& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 double dot(const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 Vec3d crossV(const Vec3d& a, const Vec3d& b) {
     return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
@@ -186,24 +185,6 @@ std::vector<std::array<double, 2>> strutCrossSection(zome::Color color) {
     return s;
 }
 
-Vec3d strutCrossSectionFrame(int hole) {
-    const Vec3d d = zome::holeDirection(hole);
-    const zome::Color target =
-        zome::holeColor(hole) == zome::Color::Red ? zome::Color::Yellow : zome::Color::Red;
-    const auto [first, last] = zome::holeRange(target);
-    double best = -2.0;
-    Vec3d u{};
-    for (int h = first; h < last; ++h) {
-        const Vec3d& e = zome::holeDirection(h);
-        const double c = dot(d, e);
-        if (c > best + 1e-9) {  // ties (symmetric neighbours): the lowest hole number
-            best = c;
-            u = sub(e, {c * d[0], c * d[1], c * d[2]});
-        }
-    }
-    return normalized(u);
-}
-
 GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& options) {
     if (!input.pieceNames.empty() && input.pieceNames.size() != input.pieces.size())
         throw Error(ErrorCode::Usage, "preview: " + std::to_string(input.pieceNames.size()) +
@@ -324,7 +305,7 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
                     mesh = int(scene.meshes.size() - 1);
                 }
                 const Vec3d d = zome::holeDirection(s.holeA);
-                const Vec3d u = strutCrossSectionFrame(s.holeA);
+                const Vec3d& u = zome::holeSectionAxis(s.holeA);
                 GlbNode node;
                 node.name = "strut-" + std::to_string(id);
                 node.mesh = mesh;

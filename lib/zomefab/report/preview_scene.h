@@ -37,16 +37,10 @@ struct PreviewOptions {
 };
 
 /// Cross-section of a strut as a convex polygon (counter-clockwise, mm) in the plane normal to
-/// the strut: x points along the "long" direction chosen by strutCrossSectionFrame(). Blue: the
+/// the strut: x points along zome::holeSectionAxis() of the hole. Blue: the
 /// golden rectangle 5.46 × 3.38 mm; yellow: the equilateral triangle of edge 5.46 mm (circumradius
 /// 3.15 mm); red: the regular pentagon of circumradius 2.87 mm (docs/zome.md §3, vZome's models).
 std::vector<std::array<double, 2>> strutCrossSection(zome::Color color);
-
-/// Unit vector normal to hole @p hole's direction that the cross-section's x axis follows: towards
-/// the nearest red axis for blue (the rectangle's long side) and yellow (a triangle corner), towards
-/// the nearest yellow axis for red (a pentagon corner), as on the Zome ball, whose holes are the faces
-/// of a small rhombicosidodecahedron (vertex figure triangle–rectangle–pentagon–rectangle).
-Vec3d strutCrossSectionFrame(int hole);
 
 /// Builds the scene. Node names: "piece-NN" (or pieceNames), "ball-<id>", "strut-<id>" with the
 /// frame's ids; group nodes "zomefab" (root), "pieces", "balls", "struts".

@@ -128,6 +128,22 @@ Built build() {
             t.cosine[size_t(i)][size_t(j)] = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
         }
     }
+    for (int hole = 0; hole < kHoleCount; ++hole) {
+        HoleInfo& h = t.holes[size_t(hole)];
+        const Color target = h.color == Color::Red ? Color::Yellow : Color::Red;
+        double best = -2.0;
+        Vec3d u{};
+        for (int other = kFirstHole[int(target)]; other < kFirstHole[int(target)] + 2 * kAxesOf[int(target)]; ++other) {
+            const double c = t.cosine[size_t(hole)][size_t(other)];
+            if (c > best + 1e-9) {  // ties (symmetric neighbours): the lowest hole number
+                best = c;
+                const Vec3d& e = t.holes[size_t(other)].direction;
+                u = {e[0] - c * h.direction[0], e[1] - c * h.direction[1], e[2] - c * h.direction[2]};
+            }
+        }
+        const double len = length(u);
+        h.sectionAxis = {u[0] / len, u[1] / len, u[2] / len};
+    }
     for (int hole = 0; hole < kHoleCount; ++hole)
         for (int size = 0; size < kSizeCount; ++size)
             built.catalogue.insert(t.holes[size_t(hole)].vector[size_t(size)], hole, size);

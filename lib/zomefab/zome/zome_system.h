@@ -54,6 +54,13 @@ struct HoleInfo {
     std::array<GoldenVector3, kSizeCount> vector{};
     std::array<Vec3d, kSizeCount> vectorUnits{};  ///< the same in double precision
     Vec3d direction{};                            ///< unit direction (double)
+    /// Unit vector normal to `direction` that orients the hole's section (the face of the ball, a
+    /// small rhombicosidodecahedron: vertex figure triangle–rectangle–pentagon–rectangle): blue, the
+    /// golden rectangle's long side, towards the two nearest red axes; yellow, a triangle corner,
+    /// towards the nearest red axis; red, a pentagon corner, towards the nearest yellow axis. On +z
+    /// the blue rectangle's long side is x (zome-geometry.md §2). Of two symmetric nearest axes the
+    /// lower hole number is taken; for a blue rectangle both give the same line.
+    Vec3d sectionAxis{};
 };
 
 /// All precomputed tables; built once, thread-safe, never changes. Hot loops keep a reference.
@@ -74,6 +81,7 @@ inline int oppositeHole(int hole) { return holeInfo(hole).opposite; }
 /// Exact size-@p size strut vector leaving a ball through @p hole.
 inline const GoldenVector3& strutVector(int hole, int size) { return holeInfo(hole).vector[size_t(size)]; }
 inline const Vec3d& holeDirection(int hole) { return holeInfo(hole).direction; }
+inline const Vec3d& holeSectionAxis(int hole) { return holeInfo(hole).sectionAxis; }
 inline double holeCosine(int holeA, int holeB) { return zomeTables().cosine[size_t(holeA)][size_t(holeB)]; }
 
 /// A catalogue strut: the hole it leaves the start ball from, its colour and size. The end ball

@@ -28,10 +28,6 @@ std::string serializeStl(const TriMesh& mesh);
 std::string serializeObj(const TriMesh& mesh);
 std::string serializePly(const TriMesh& mesh);
 
-/// Merges bit-identical positions (after mapping -0 to +0) into one vertex, keeping the order of
-/// first appearance so the result does not depend on hashing.
-void weldIdenticalVertices(TriMesh& mesh);
-
 /// Error(InvalidInput) for @p source.
 [[noreturn]] inline void fail(const std::string& source, const std::string& message) {
     throw Error(ErrorCode::InvalidInput, message, source);
