@@ -72,14 +72,33 @@ TEST_CASE("zf-pieces: one closed STL per piece, pieces.3mf and pieces.json") {
         for (const nlohmann::json& t : p["tenons"]) {
             CHECK(t["ball"].is_number_unsigned());
             const int hole = t["hole"];
-            CHECK((hole == 0 || hole == 1 || hole == 2 || hole == 15 || hole == 16 || hole == 17));
+            CHECK((hole >= 0 && hole < 30));  // a blue hole
         }
     }
     CHECK(tenons >= 4);
+    CHECK(j["options"]["tenons"]["holes"] == "blue");
     CHECK(test::readFile(r.out("pieces.3mf")).substr(0, 2) == "PK");
     const nlohmann::json report = nlohmann::json::parse(test::readFile(r.dir.file("report.json")));
     CHECK(report["pieces"] == 4);
     CHECK(report["tool"] == "zf-pieces");
+}
+
+TEST_CASE("zf-pieces: --tenon-lattice-holes-only keeps the tenons on the paper's six holes") {
+    const Run& r = shared();
+    REQUIRE(r.exitCode == 0);
+    const std::string out = r.dir.file("lattice");
+    REQUIRE(test::runShell(test::toolPath("zf-pieces") + " " + r.dir.file("shell.vdb") + " " + r.dir.file("frame.json") + " " +
+                           r.dir.file("partition.json") + " -q --tenon-lattice-holes-only -o " + out) == 0);
+    const nlohmann::json j = nlohmann::json::parse(test::readFile(out + "/pieces.json"));
+    CHECK(j["options"]["tenons"]["holes"] == "lattice");
+    size_t tenons = 0;
+    for (const nlohmann::json& p : j["pieces"])
+        for (const nlohmann::json& t : p["tenons"]) {
+            ++tenons;
+            const int hole = t["hole"];
+            CHECK((hole == 0 || hole == 1 || hole == 2 || hole == 15 || hole == 16 || hole == 17));
+        }
+    CHECK(tenons >= 4);
 }
 
 TEST_CASE("zf-pieces: the same bytes with 1 and 2 threads") {
