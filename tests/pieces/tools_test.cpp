@@ -29,9 +29,12 @@ struct Run {
     int exitCode = -1;
     Run() {
         pieces::test::writeToolInputs(dir.path().string());
-        exitCode = test::runShell(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " + dir.file("frame.json") + " " +
-                       dir.file("partition.json") + " -q --threads 2 -o " + dir.file("out") + " --report " +
-                       dir.file("report.json"));
+        exitCode = runInto("out", "--threads 2 --report " + dir.file("report.json"));
+    }
+    /// zf-pieces on the shared inputs into dir/@p outName with @p options; its exit code.
+    int runInto(const std::string& outName, const std::string& options) const {
+        return test::runShell(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " + dir.file("frame.json") +
+                              " " + dir.file("partition.json") + " -q " + options + " -o " + dir.file(outName));
     }
     std::string out(const std::string& name) const { return dir.file("out/" + name); }
 };
@@ -86,9 +89,8 @@ TEST_CASE("zf-pieces: one closed STL per piece, pieces.3mf and pieces.json") {
 TEST_CASE("zf-pieces: --tenon-lattice-holes-only keeps the tenons on the paper's six holes") {
     const Run& r = shared();
     REQUIRE(r.exitCode == 0);
+    REQUIRE(r.runInto("lattice", "--tenon-lattice-holes-only") == 0);
     const std::string out = r.dir.file("lattice");
-    REQUIRE(test::runShell(test::toolPath("zf-pieces") + " " + r.dir.file("shell.vdb") + " " + r.dir.file("frame.json") + " " +
-                           r.dir.file("partition.json") + " -q --tenon-lattice-holes-only -o " + out) == 0);
     const nlohmann::json j = nlohmann::json::parse(test::readFile(out + "/pieces.json"));
     CHECK(j["options"]["tenons"]["holes"] == "lattice");
     size_t tenons = 0;
@@ -104,9 +106,8 @@ TEST_CASE("zf-pieces: --tenon-lattice-holes-only keeps the tenons on the paper's
 TEST_CASE("zf-pieces: the same bytes with 1 and 2 threads") {
     const Run& r = shared();
     REQUIRE(r.exitCode == 0);
+    REQUIRE(r.runInto("one-thread", "--threads 1") == 0);
     const std::string other = r.dir.file("one-thread");
-    REQUIRE(test::runShell(test::toolPath("zf-pieces") + " " + r.dir.file("shell.vdb") + " " + r.dir.file("frame.json") + " " +
-                r.dir.file("partition.json") + " -q --threads 1 -o " + other) == 0);
     size_t files = 0;
     for (const auto& e : fs::directory_iterator(r.dir.file("out"))) {
         ++files;
