@@ -18,6 +18,7 @@
 #include "common/cli.h"
 #include "common/stage_options.h"
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 #include "zomefab/core/version.h"
 #include "zomefab/io/file_io.h"
 #include "zomefab/io/mesh_io.h"
@@ -74,7 +75,9 @@ struct RunCommand {
         scale.addTo(run);
         tool.addFormatOption("--in-format", inFormat, {"stl", "obj", "ply", "gltf", "glb"}, "Input format (for -)");
         run.add_flag("--repair", options.validate.repair, "Close small holes of an open mesh");
-        run.add_option("--voxel-mm", options.field.voxelMm, "Voxel of the object and shell level sets (at most 1.54 for the tenon pegs)")
+        run.add_option("--voxel-mm", options.field.voxelMm,
+                       formatNumbers("Voxel of the object and shell level sets (at most %.2f for the tenon pegs)",
+                                     pieces::maxVoxelForPegsMm(options.pieces.tenons)))
             ->capture_default_str();
         run.add_option("--shell-mm", options.shell.shellMm, "Shell wall thickness (paper: dMin = 16 mm)")
             ->capture_default_str();

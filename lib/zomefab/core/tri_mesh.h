@@ -36,6 +36,9 @@ struct Box3d {
     Vec3d size() const;
 };
 
+/// A triangle that names one vertex twice: no area and no proper edges.
+inline bool hasRepeatedIndex(const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
+
 /// Bounding box of the mesh's referenced and unreferenced vertices.
 Box3d boundingBox(const TriMesh& mesh);
 

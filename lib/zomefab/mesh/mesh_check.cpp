@@ -31,8 +31,6 @@ private:
     std::vector<uint32_t> mParent;
 };
 
-bool hasRepeatedIndex(const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
-
 Vec3d toDouble(const Vec3f& p) { return {p[0], p[1], p[2]}; }
 Vec3d sub(const Vec3d& a, const Vec3d& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 Vec3d cross(const Vec3d& a, const Vec3d& b) {

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <memory>
 #include <numeric>
@@ -14,6 +13,7 @@
 #include <string>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 #include "zomefab/partition/alpha_expansion.h"
 #include "zomefab/partition/face_graph.h"
 
@@ -31,13 +31,7 @@ double dist2(const Vec3d& a, const Vec3d& b) {
 
 Vec3d toD(const Vec3f& p) { return {double(p[0]), double(p[1]), double(p[2])}; }
 
-std::string fmt(const char* format, double a, double b = 0, double c = 0, double d = 0) {
-    char buf[256];
-    std::snprintf(buf, sizeof(buf), format, a, b, c, d);
-    return buf;
-}
-
-std::string sizeText(const Vec3d& v) { return fmt("%.0f x %.0f x %.0f mm", v[0], v[1], v[2]); }
+std::string sizeText(const Vec3d& v) { return formatNumbers("%.0f x %.0f x %.0f mm", v[0], v[1], v[2]); }
 
 /// Closest point of triangle abc to p, squared distance (Ericson, Real-Time Collision Detection §5.1.5).
 double pointTriangleDist2(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
@@ -245,6 +239,11 @@ bool fitsTrivially(const std::vector<Vec3d>& pts, const Vec3d& printer, double m
     return e[0] <= p[0] && e[1] <= p[1] && e[2] <= p[2];
 }
 
+/// The schedule's fit test (docs/partition.md §4): the quick accept, else the oriented-box search.
+bool fitsPrinter(const std::vector<Vec3d>& pts, const Vec3d& printer, double margin) {
+    return fitsTrivially(pts, printer, margin) || fitInPrinter(pts, printer, margin).fits;
+}
+
 struct Context {
     const TriMesh& mesh;
     const FaceGraph& graph;
@@ -267,10 +266,7 @@ std::vector<char> fitsEach(Context& cx, const std::vector<std::vector<uint32_t>>
     std::vector<std::vector<Vec3d>> pts(n);
     for (size_t c = 0; c < n; ++c) pts[c] = faceVertices(cx.mesh, faceSets[c], cx.stamp, cx.stampValue);
     std::vector<char> fits(n, 1);
-    tbb::parallel_for(size_t(0), n, [&](size_t c) {
-        if (fitsTrivially(pts[c], cx.opt.printerMm, cx.opt.fitMarginMm)) return;
-        fits[c] = fitInPrinter(pts[c], cx.opt.printerMm, cx.opt.fitMarginMm).fits ? 1 : 0;
-    });
+    tbb::parallel_for(size_t(0), n, [&](size_t c) { fits[c] = fitsPrinter(pts[c], cx.opt.printerMm, cx.opt.fitMarginMm); });
     return fits;
 }
 
@@ -350,8 +346,8 @@ void checkPartitionOptions(const PartitionOptions& o, const zome::ZomeScale& sca
     const double minSide = std::min({o.printerMm[0], o.printerMm[1], o.printerMm[2]});
     if (minSide < scale.ballDiameterMm + 2.0 * o.fitMarginMm)
         usage("printer volume " + sizeText(o.printerMm) + " is smaller than a Zome ball (" +
-              fmt("%.1f mm across", scale.ballDiameterMm) +
-              (o.fitMarginMm > 0 ? fmt(" plus 2 x %.1f mm margin", o.fitMarginMm) : std::string()) + ")");
+              formatNumbers("%.1f mm across", scale.ballDiameterMm) +
+              (o.fitMarginMm > 0 ? formatNumbers(" plus 2 x %.1f mm margin", o.fitMarginMm) : std::string()) + ")");
     if (o.candidateCount < 1) usage("k (candidate labels per triangle) must be >= 1");
     if (!(o.dataWeight > 0.0) || !std::isfinite(o.dataWeight)) usage("w_data must be > 0");
     if (!(o.saliencyWeight >= 0.0) || !std::isfinite(o.saliencyWeight)) usage("w_saliency must be >= 0");
@@ -429,9 +425,6 @@ RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph, c
             if (regionOf[h] != regionOf[f]) seam[regionOf[f]][regionOf[h]] += sharedEdgeMm(meshMm, f, h);
         }
     }
-    auto fits = [&](const std::vector<Vec3d>& p) {
-        return fitsTrivially(p, printerMm, marginMm) || fitInPrinter(p, printerMm, marginMm).fits;
-    };
     Dsu dsu(regionCount);
     std::vector<char> isRoot(regionCount, 1);
     // Pairs (lower root, higher root) whose union was tested and does not fit. A pair is tested
@@ -459,7 +452,7 @@ RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph, c
                 std::vector<Vec3d> u(pts[r]);
                 const std::vector<Vec3d>& other = pts[byLength[i].second];
                 u.insert(u.end(), other.begin(), other.end());
-                isFit[i] = fits(u) ? 1 : 0;
+                isFit[i] = fitsPrinter(u, printerMm, marginMm);
             });
             uint32_t into = kNone;
             for (size_t i = 0; i < byLength.size(); ++i) {
@@ -569,8 +562,8 @@ private:
             if (out > mB0)
                 throw Error(ErrorCode::InvalidInput,
                             "frame and mesh do not match: ball " + std::to_string(mLabelBalls[l]) +
-                                fmt(" at (%.1f, %.1f, %.1f) mm", mBallMm[l][0], mBallMm[l][1], mBallMm[l][2]) +
-                                fmt(" lies %.1f mm outside the mesh's bounding box (check transform_mm)", out));
+                                formatNumbers(" at (%.1f, %.1f, %.1f) mm", mBallMm[l][0], mBallMm[l][1], mBallMm[l][2]) +
+                                formatNumbers(" lies %.1f mm outside the mesh's bounding box (check transform_mm)", out));
         }
     }
 
@@ -608,7 +601,7 @@ private:
         const double median = d[mFaceCount / 2];
         if (median > 5.0 * mB0)
             throw Error(ErrorCode::InvalidInput,
-                        fmt("frame and mesh do not match: the surface lies a median %.0f mm (%.1f b0) from the "
+                        formatNumbers("frame and mesh do not match: the surface lies a median %.0f mm (%.1f b0) from the "
                             "nearest outermost ball (check transform_mm)",
                             median, median / mB0));
 
@@ -953,13 +946,13 @@ private:
             mRes.energyGraphCut = st.energyGraphCut;
             mRes.sweepEnergies = ae.sweepEnergies;
             mRes.graphCutPartitions = st.partitions;
-            mRun.info(fmt("w_smoothness %g: ", ws) +
+            mRun.info(formatNumbers("w_smoothness %g: ", ws) +
                       (isWholeCut ? std::string()
                                   : "re-cut " + std::to_string(st.faces) + " faces of the partitions that did not fit, ") +
-                      fmt("E %.6g -> %.6g, %.0f partitions", st.energyNearest, st.energyGraphCut, double(st.partitions)) +
+                      formatNumbers("E %.6g -> %.6g, %.0f partitions", st.energyNearest, st.energyGraphCut, double(st.partitions)) +
                       (oversized.empty() ? ", all fit the printer" : ", " + std::to_string(oversized.size()) + " too large"));
             if (!ae.isConverged)
-                mRun.warn(fmt("graph cut at w_smoothness %g stopped after %.0f sweeps before converging", ws, double(ae.sweeps)));
+                mRun.warn(formatNumbers("graph cut at w_smoothness %g stopped after %.0f sweeps before converging", ws, double(ae.sweeps)));
             mRun.progress("partition", std::min(0.6, 0.1 * (step + 1)));
             if (oversized.empty()) break;
             if (ws * mOpt.smoothnessFactor < mOpt.smoothnessMin * (1.0 - 1e-9) || ws == 0.0) {
@@ -997,7 +990,7 @@ private:
             mRes.splits += splitFaces(oversized[i]) ? 1 : 0;
         }
         if (mRes.isScheduleBottomedOut)
-            mRun.warn(fmt("the fit schedule bottomed out at w_smoothness %g with %.0f partitions larger than the "
+            mRun.warn(formatNumbers("the fit schedule bottomed out at w_smoothness %g with %.0f partitions larger than the "
                           "printer; split them",
                           ws, double(oversized.size())));
     }
@@ -1020,7 +1013,7 @@ private:
         mRes.regionMerges = m.merges;
         mRun.info(std::to_string(regionCount) + " regions, " + std::to_string(m.merges) +
                   " merged into a neighbour they fit the printer with: " + std::to_string(m.groupCount) + " regions");
-        mRun.debug(fmt("region merge: %.3f s", clock.seconds()));
+        mRun.debug(formatNumbers("region merge: %.3f s", clock.seconds()));
     }
 
     Context& context() {
@@ -1153,17 +1146,26 @@ private:
             members[c].assign(fragFaces.begin() + fragOffsets[c], fragFaces.begin() + fragOffsets[c + 1]);
         std::vector<double> area(fragArea);
         merges = 0;
-        auto tryMerge = [&](uint32_t a, uint32_t b, bool isCounted = true) {
-            a = dsu.find(a), b = dsu.find(b);
-            if (a == b) return true;
+        // The faces of roots a and b, a's first (the order the fit test samples them in).
+        auto facesOf = [&](uint32_t a, uint32_t b) {
             std::vector<uint32_t> joined(members[a]);
             joined.insert(joined.end(), members[b].begin(), members[b].end());
-            if (!cx.fitOf(joined).fits) return false;
+            return joined;
+        };
+        // Makes roots a and b one piece whose faces are @p joined.
+        auto unite = [&](uint32_t a, uint32_t b, std::vector<uint32_t> joined) {
             dsu.join(a, b);
             const uint32_t root = dsu.find(a), other = root == a ? b : a;
             members[root] = std::move(joined);
             members[other].clear();
             area[root] += area[other];
+        };
+        auto tryMerge = [&](uint32_t a, uint32_t b, bool isCounted = true) {
+            a = dsu.find(a), b = dsu.find(b);
+            if (a == b) return true;
+            std::vector<uint32_t> joined = facesOf(a, b);
+            if (!cx.fitOf(joined).fits) return false;
+            unite(a, b, std::move(joined));
             merges += isCounted ? 1 : 0;
             return true;
         };
@@ -1203,12 +1205,7 @@ private:
             for (const auto& [a, b] : touching) {
                 if (isWhole[linked.find(a)]) {
                     const uint32_t ra = dsu.find(a), rb = dsu.find(b);
-                    if (ra == rb) continue;
-                    dsu.join(ra, rb);
-                    const uint32_t root = dsu.find(ra), other = root == ra ? rb : ra;
-                    members[root].insert(members[root].end(), members[other].begin(), members[other].end());
-                    members[other].clear();
-                    area[root] += area[other];
+                    if (ra != rb) unite(ra, rb, facesOf(std::min(ra, rb), std::max(ra, rb)));  // the lower id is the root
                 } else {
                     tryMerge(a, b, false);
                 }
@@ -1238,13 +1235,7 @@ private:
                     const uint32_t h = mGraph.neighbors[i];
                     const uint32_t other = dsu.find(fragOf[h]);
                     if (other == root) continue;
-                    const auto& tf = mMesh.triangles[f];
-                    const auto& th = mMesh.triangles[h];
-                    std::vector<uint32_t> shared;
-                    for (uint32_t v : tf)
-                        if (v == th[0] || v == th[1] || v == th[2]) shared.push_back(v);
-                    if (shared.size() >= 2)
-                        seam[other] += std::sqrt(dist2(toD(mMesh.positions[shared[0]]), toD(mMesh.positions[shared[1]])));
+                    seam[other] += sharedEdgeMm(mMesh, f, h);  // graph neighbours share an edge
                 }
             std::vector<std::pair<double, uint32_t>> byLength;
             for (const auto& [o, len] : seam) byLength.push_back({-len, o});

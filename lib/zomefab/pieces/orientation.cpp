@@ -129,6 +129,22 @@ double lowestAlong(const MeshD& m, const Vec3d& up) {
     return lowest;
 }
 
+/// The part of a triangle (corners @p v, heights @p z along "up") at or below @p top: a convex
+/// polygon of up to 4 corners, in order, with their heights. Returns the number of corners.
+int clipBelow(const Vec3d* const v[3], const double z[3], double top, Vec3d corner[4], double height[4]) {
+    int n = 0;
+    for (int e = 0; e < 3; ++e) {
+        const int f = (e + 1) % 3;
+        const bool isIn = z[e] <= top, isNextIn = z[f] <= top;
+        if (isIn) corner[n] = *v[e], height[n] = z[e], ++n;
+        if (isIn != isNextIn) {
+            const double s = (top - z[e]) / (z[f] - z[e]);
+            corner[n] = madd(*v[e], s, sub(*v[f], *v[e])), height[n] = top, ++n;
+        }
+    }
+    return n;
+}
+
 /// Cross-section area of the closed mesh at @p h above its lowest point along @p down. The solid
 /// below the section is closed by the section itself, so the section's area is minus the flux of
 /// "up" through the part of the mesh below it: the triangles there, clipped at the section.
@@ -146,13 +162,8 @@ double sectionArea(const MeshD& m, const Vec3d& down, double h) {
             continue;
         }
         Vec3d poly[4];
-        int n = 0;
-        for (int e = 0; e < 3; ++e) {
-            const int f = (e + 1) % 3;
-            const bool isIn = z[e] <= top, isNextIn = z[f] <= top;
-            if (isIn) poly[n++] = *v[e];
-            if (isIn != isNextIn) poly[n++] = madd(*v[e], (top - z[e]) / (z[f] - z[e]), sub(*v[f], *v[e]));
-        }
+        double height[4];
+        const int n = clipBelow(v, z, top, poly, height);
         Vec3d area{0, 0, 0};
         for (int k = 1; k + 1 < n; ++k) area = add(area, cross(sub(poly[k], poly[0]), sub(poly[k + 1], poly[0])));
         flux += 0.5 * dot(area, up);
@@ -180,16 +191,7 @@ double contactMm2(const MeshD& m, const Vec3d& down, double h) {
         // its value at the centroid.
         Vec3d corner[4];
         double height[4];
-        int n = 0;
-        for (int e = 0; e < 3; ++e) {
-            const int f = (e + 1) % 3;
-            const bool isIn = z[e] <= top, isNextIn = z[f] <= top;
-            if (isIn) corner[n] = *v[e], height[n] = z[e], ++n;
-            if (isIn != isNextIn) {
-                const double s = (top - z[e]) / (z[f] - z[e]);
-                corner[n] = madd(*v[e], s, sub(*v[f], *v[e])), height[n] = top, ++n;
-            }
-        }
+        const int n = clipBelow(v, z, top, corner, height);
         for (int k = 1; k + 1 < n; ++k) {
             const double projected = -0.5 * dot(cross(sub(corner[k], corner[0]), sub(corner[k + 1], corner[0])), up);
             const double zMean = (height[0] + height[k] + height[k + 1]) / 3.0 - lowest;

@@ -930,8 +930,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
             // same point. Welded, the zero-area triangles between them repeat a vertex and go, so
             // the STL has no degenerate facet.
             weldIdenticalVertices(mesh);
-            mesh.triangles.erase(std::remove_if(mesh.triangles.begin(), mesh.triangles.end(),
-                                                [](const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }),
+            mesh.triangles.erase(std::remove_if(mesh.triangles.begin(), mesh.triangles.end(), hasRepeatedIndex),
                                  mesh.triangles.end());
             piece.mesh = std::move(mesh);
         }

@@ -2,11 +2,11 @@
 #include "zomefab/pipeline/pipeline.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 #include <functional>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 #include "zomefab/core/version.h"
 #include "zomefab/frame/outermost.h"
 #include "zomefab/io/file_io.h"
@@ -35,12 +35,6 @@ auto timedStage(const std::string& name, RunResult& result, RunContext& context,
     return value;
 }
 
-std::string format(const char* pattern, double a, double b = 0, double c = 0, double d = 0) {
-    char text[256];
-    std::snprintf(text, sizeof text, pattern, a, b, c, d);
-    return text;
-}
-
 /// Errors that stages raise about the object itself belong to the input file.
 [[noreturn]] void rethrowAboutInput(const Error& e, const std::string& sourceName) {
     if (e.code() == ErrorCode::Usage || e.code() == ErrorCode::Cancelled || e.code() == ErrorCode::Internal)
@@ -66,9 +60,9 @@ void checkRunOptions(const RunOptions& options) {
     // The pieces stage would find this out only after the level sets; say it before any work.
     const double maxVoxelMm = pieces::maxVoxelForPegsMm(options.pieces.tenons);
     if (options.pieces.tenons.maxPerPiece > 0 && options.field.voxelMm > maxVoxelMm)
-        throw Error(ErrorCode::Usage, "--voxel-mm " + format("%g", options.field.voxelMm) + ": the tenon pegs (" +
-                                          format("%.2f", pieces::pegShortMm(options.pieces.tenons)) +
-                                          " mm thick) need a voxel of at most " + format("%.2f", maxVoxelMm) + " mm");
+        throw Error(ErrorCode::Usage, "--voxel-mm " + formatNumbers("%g", options.field.voxelMm) + ": the tenon pegs (" +
+                                          formatNumbers("%.2f", pieces::pegShortMm(options.pieces.tenons)) +
+                                          " mm thick) need a voxel of at most " + formatNumbers("%.2f", maxVoxelMm) + " mm");
     report::checkCostOptions(options.cost);
 }
 
@@ -199,19 +193,19 @@ std::vector<std::string> runSummaryLines(const RunResult& result) {
         tenons += piece.tenons.size();
         fewTenons += !piece.tenonShortfall.empty();
     }
-    lines.push_back(format("%.0f x %.0f x %.0f mm", result.scaled.sizeMm[0], result.scaled.sizeMm[1],
+    lines.push_back(formatNumbers("%.0f x %.0f x %.0f mm", result.scaled.sizeMm[0], result.scaled.sizeMm[1],
                            result.scaled.sizeMm[2]) +
                     ": frame of " + std::to_string(parts.balls) + " balls and " + std::to_string(parts.strutTotal()) +
                     " struts (" + std::to_string(result.assembly.layers) + " layers to build), " +
                     std::to_string(result.pieces.pieces.size()) + " printed pieces with " + std::to_string(tenons) +
                     " tenons" + (fewTenons ? " (" + std::to_string(fewTenons) + " pieces with fewer than planned)" : ""));
     for (const report::CostCase& c : result.cost.cases) {
-        lines.push_back(c.name + format(" (%.0f%% infill): ", c.infillPercent) +
-                        format("print %.1f h, %.2f kg, %.2f USD", c.zomefab.print.hours(), c.zomefab.filament.massG / 1000.0,
+        lines.push_back(c.name + formatNumbers(" (%.0f%% infill): ", c.infillPercent) +
+                        formatNumbers("print %.1f h, %.2f kg, %.2f USD", c.zomefab.print.hours(), c.zomefab.filament.massG / 1000.0,
                                c.zomefab.filament.costUsd) +
-                        format(" + Zometool %.2f USD, %.1f h to build", c.zomefab.zomeUsd, c.zomefab.assemblyHours) +
-                        format("; whole object %.1f h, %.2f USD", c.baseline.print.hours(), c.baseline.totalUsd()) +
-                        format(": saves %.0f%% time, %.0f%% material", c.savedTimePercent, c.savedMaterialPercent));
+                        formatNumbers(" + Zometool %.2f USD, %.1f h to build", c.zomefab.zomeUsd, c.zomefab.assemblyHours) +
+                        formatNumbers("; whole object %.1f h, %.2f USD", c.baseline.print.hours(), c.baseline.totalUsd()) +
+                        formatNumbers(": saves %.0f%% time, %.0f%% material", c.savedTimePercent, c.savedMaterialPercent));
     }
     return lines;
 }

@@ -2,11 +2,11 @@
 #include "zomefab/report/assembly_guide.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <map>
 #include <string>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 #include "zomefab/core/version.h"
 
 namespace zomefab::report {
@@ -20,12 +20,6 @@ bool lowerThan(const zome::Structure& frame, zome::BallId a, zome::BallId b) {
     if (pa[1] != pb[1]) return pa[1] < pb[1];
     if (pa[0] != pb[0]) return pa[0] < pb[0];
     return a < b;
-}
-
-std::string format(const char* fmt, double a, double b, double c) {
-    char buf[128];
-    std::snprintf(buf, sizeof buf, fmt, a, b, c);
-    return buf;
 }
 
 std::string ballName(zome::BallId id) { return "ball-" + std::to_string(id); }
@@ -147,12 +141,12 @@ std::string assemblyGuideMarkdown(const AssemblyGuide& guide, const zome::PriceO
             md += "\n### Layer " + std::to_string(layer) + "\n";
         }
         md += "\n**" + ballName(step.ball) + "** at " +
-              format("(%.1f, %.1f, %.1f) mm", step.positionMm[0], step.positionMm[1], step.positionMm[2]) +
+              formatNumbers("(%.1f, %.1f, %.1f) mm", step.positionMm[0], step.positionMm[1], step.positionMm[2]) +
               (step.struts.empty() ? ": nothing new to attach\n" : "\n");
         for (const StrutStep& s : step.struts) {
             const Vec3d& d = zome::holeDirection(s.hole);
             md += "- " + zome::partName(s.color, s.size) + " (" + zome::colorName(s.color) + ") in hole " +
-                  std::to_string(s.hole) + format(" (%+.2f, %+.2f, %+.2f)", d[0], d[1], d[2]) + " to " +
+                  std::to_string(s.hole) + formatNumbers(" (%+.2f, %+.2f, %+.2f)", d[0], d[1], d[2]) + " to " +
                   ballName(s.toBall) + (s.isNewBall ? " (new)" : "") + ", its hole " +
                   std::to_string(s.toHole) + "\n";
         }
