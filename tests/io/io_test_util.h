@@ -41,16 +41,4 @@ inline bool sameGeometry(const TriMesh& a, const TriMesh& b) {
     return true;
 }
 
-/// Signed volume by the divergence theorem (positive for an outward closed mesh).
-inline double signedVolume(const TriMesh& m) {
-    double v = 0;
-    for (const Triangle& t : m.triangles) {
-        const Vec3f &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
-        v += double(a[0]) * (double(b[1]) * c[2] - double(b[2]) * c[1]) -
-             double(a[1]) * (double(b[0]) * c[2] - double(b[2]) * c[0]) +
-             double(a[2]) * (double(b[0]) * c[1] - double(b[1]) * c[0]);
-    }
-    return v / 6.0;
-}
-
 }  // namespace zomefab::test

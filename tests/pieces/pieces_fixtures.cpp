@@ -8,9 +8,10 @@
 #include "test_util.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/run_context.h"
-#include "zomefab/pieces/detail/vec.h"
-#include "zomefab/zome/golden.h"
+#include "zomefab/core/vec.h"
+#include "zomefab/pieces/detail/box_distance.h"
 #include "zomefab/sdf/vdb_file.h"
+#include "zomefab/zome/golden.h"
 #include "zomefab/zome/structure_json.h"
 
 namespace zomefab::pieces::test {

@@ -20,8 +20,8 @@ TEST_CASE("mesh_clip: a box cut across keeps the exact part, closed and outward"
     const TriMesh above = clipByPlane(box, 0, 3.0, false);
     CHECK(isClosedOriented(below));
     CHECK(isClosedOriented(above));
-    CHECK(meshVolumeMm3(below) == doctest::Approx(3.0 * 600.0).epsilon(1e-6));
-    CHECK(meshVolumeMm3(above) == doctest::Approx(7.0 * 600.0).epsilon(1e-6));
+    CHECK(signedVolume(below) == doctest::Approx(3.0 * 600.0).epsilon(1e-6));
+    CHECK(signedVolume(above) == doctest::Approx(7.0 * 600.0).epsilon(1e-6));
     CHECK(meshAreaMm2(below) == doctest::Approx(2 * (3 * 20 + 3 * 30 + 20 * 30)).epsilon(1e-6));
     const Box3d b = boundingBox(below);
     CHECK(b.max[0] == doctest::Approx(3.0));
@@ -33,22 +33,22 @@ TEST_CASE("mesh_clip: nothing or everything on the kept side") {
     CHECK(clipByPlane(box, 2, -1.0, true).triangles.empty());
     const TriMesh all = clipByPlane(box, 2, 5.0, true);
     CHECK(all.triangles.size() == box.triangles.size());
-    CHECK(meshVolumeMm3(all) == doctest::Approx(1.0));
+    CHECK(signedVolume(all) == doctest::Approx(1.0));
 }
 
 TEST_CASE("mesh_clip: the cap of a hollow sphere is an annulus (hole bridged into the outer loop)") {
     // 49 rings: no vertex on the equator, the cut crosses every meridian edge.
     const TriMesh shell = sphereShell({0, 0, 0}, 50, 10, 49, 96);
-    const double whole = meshVolumeMm3(shell);
+    const double whole = signedVolume(shell);
     for (bool keepBelow : {true, false}) {
         const TriMesh half = clipByPlane(shell, 2, 0.0, keepBelow);
         CHECK(isClosedOriented(half));
-        CHECK(meshVolumeMm3(half) == doctest::Approx(0.5 * whole).epsilon(1e-6));
+        CHECK(signedVolume(half) == doctest::Approx(0.5 * whole).epsilon(1e-6));
     }
     // Through x: the cap lies in the yz plane.
     const TriMesh side = clipByPlane(shell, 0, 0.0, false);
     CHECK(isClosedOriented(side));
-    CHECK(meshVolumeMm3(side) == doctest::Approx(0.5 * whole).epsilon(1e-3));
+    CHECK(signedVolume(side) == doctest::Approx(0.5 * whole).epsilon(1e-3));
 }
 
 TEST_CASE("mesh_clip: two cavities in one cut and two separate outer loops") {
@@ -58,12 +58,12 @@ TEST_CASE("mesh_clip: two cavities in one cut and two separate outer loops") {
         merged(reversed(makeBox({10, 10, 10}, {40, 30, 30})), reversed(makeBox({60, 10, 10}, {90, 30, 30}))));
     const TriMesh cut = clipByPlane(twoCavities, 2, 20.0, true);
     CHECK(isClosedOriented(cut));
-    CHECK(meshVolumeMm3(cut) == doctest::Approx(100.0 * 40 * 20 - 2 * 30.0 * 20 * 10).epsilon(1e-6));
+    CHECK(signedVolume(cut) == doctest::Approx(100.0 * 40 * 20 - 2 * 30.0 * 20 * 10).epsilon(1e-6));
     // Two disjoint boxes cut by one plane: two caps.
     const TriMesh two = merged(makeBox({0, 0, 0}, {10, 10, 10}), makeBox({20, 0, 0}, {30, 10, 10}));
     const TriMesh lower = clipByPlane(two, 2, 4.0, true);
     CHECK(isClosedOriented(lower));
-    CHECK(meshVolumeMm3(lower) == doctest::Approx(2 * 400.0).epsilon(1e-6));
+    CHECK(signedVolume(lower) == doctest::Approx(2 * 400.0).epsilon(1e-6));
 }
 
 TEST_CASE("mesh_clip: vertices exactly on the plane move the plane a little, not the result's topology") {
@@ -71,7 +71,7 @@ TEST_CASE("mesh_clip: vertices exactly on the plane move the plane a little, not
     const TriMesh sphere = makeSphere({0, 0, 0}, 20, 48, 96);
     const TriMesh top = clipByPlane(sphere, 2, 0.0, false);
     CHECK(isClosedOriented(top));
-    CHECK(meshVolumeMm3(top) == doctest::Approx(0.5 * meshVolumeMm3(sphere)).epsilon(1e-3));
+    CHECK(signedVolume(top) == doctest::Approx(0.5 * signedVolume(sphere)).epsilon(1e-3));
     const Box3d b = boundingBox(top);
     CHECK(std::abs(b.min[2]) <= 0.01);
 }
@@ -84,7 +84,7 @@ TEST_CASE("mesh_clip: clipToBox of a sphere around a cube gives the cube") {
     box.max = {5, 5, 5};
     const TriMesh cube = clipToBox(sphere, box);
     CHECK(isClosedOriented(cube));
-    CHECK(meshVolumeMm3(cube) == doctest::Approx(1000.0).epsilon(1e-5));
+    CHECK(signedVolume(cube) == doctest::Approx(1000.0).epsilon(1e-5));
     CHECK(meshAreaMm2(cube) == doctest::Approx(600.0).epsilon(1e-5));
 }
 
@@ -93,7 +93,7 @@ TEST_CASE("mesh_clip: the shell piece fixture is closed and has the octant's vol
     CHECK(isClosedOriented(piece));
     const double pi = std::acos(-1.0);
     const double exact = (4.0 / 3.0) * pi * (80.0 * 80 * 80 - 64.0 * 64 * 64) / 8.0;
-    CHECK(meshVolumeMm3(piece) == doctest::Approx(exact).epsilon(0.01));  // tessellation
+    CHECK(signedVolume(piece) == doctest::Approx(exact).epsilon(0.01));  // tessellation
 }
 
 TEST_CASE("mesh_clip: same input, same output") {

@@ -66,7 +66,7 @@ TEST_CASE("print_estimate: solid parts use all their volume; thin walls are all 
     for (const TriMesh& thin : {makeBox({0, 0, 0}, {100, 100, 1}), hollowCube(60, 1)}) {
         const PrintEstimate e = estimatePrint(thin, withInfill(20));
         CHECK(e.infillMm3 == doctest::Approx(0.0));
-        CHECK(e.filamentMm3 == doctest::Approx(meshVolumeMm3(thin)));
+        CHECK(e.filamentMm3 == doctest::Approx(signedVolume(thin)));
     }
 }
 
@@ -107,7 +107,7 @@ TEST_CASE("print_estimate: parts are turned onto their largest flat face") {
     const TriMesh lower = clipByPlane(makeSphere({0, 0, 0}, 30, 31, 64), 2, 0.0, true);
     const TriMesh turned = orientOnBed(lower, {200, 200, 200});
     CHECK(isClosedOriented(turned));
-    CHECK(meshVolumeMm3(turned) == doctest::Approx(meshVolumeMm3(lower)).epsilon(1e-6));
+    CHECK(signedVolume(turned) == doctest::Approx(signedVolume(lower)).epsilon(1e-6));
     const Box3d b = boundingBox(turned);
     CHECK(b.min[2] == 0.0);
     double bedArea = 0.0;
@@ -138,7 +138,7 @@ TEST_CASE("print_estimate: the octree baseline cuts until every part fits, and k
         for (const TriMesh& p : parts) {
             CHECK(isClosedOriented(p));
             CHECK(fitsPrinter(boundingBox(p).size(), {200, 200, 200}));
-            volume += meshVolumeMm3(p);
+            volume += signedVolume(p);
         }
         CHECK(volume == doctest::Approx(3e6).epsilon(1e-6));
     }
@@ -153,9 +153,9 @@ TEST_CASE("print_estimate: the octree baseline cuts until every part fits, and k
         for (const TriMesh& p : parts) {
             CHECK(isClosedOriented(p));
             CHECK(fitsPrinter(boundingBox(p).size(), {200, 200, 200}));
-            volume += meshVolumeMm3(p);
+            volume += signedVolume(p);
         }
-        CHECK(volume == doctest::Approx(meshVolumeMm3(bunny)).epsilon(1e-4));
+        CHECK(volume == doctest::Approx(signedVolume(bunny)).epsilon(1e-4));
     }
     CHECK_THROWS_AS(octreeParts(makeBox({0, 0, 0}, {10, 10, 10}), {0, 200, 200}), Error);
 }

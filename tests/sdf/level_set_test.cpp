@@ -63,7 +63,7 @@ TEST_CASE("level_set: sphere volume within 1% and surface within half a voxel") 
     CHECK(std::abs(ls.insideVolumeMm3() / analyticVolume - 1) < 0.01);
 
     const TriMesh mesh = levelSetToMesh(ls, {}, RunContext::silent());
-    CHECK(std::abs(test::signedVolume(mesh) / analyticVolume - 1) < 0.01);
+    CHECK(std::abs(signedVolume(mesh) / analyticVolume - 1) < 0.01);
     double worst = 0;
     for (const Vec3f& p : mesh.positions) worst = std::max(worst, std::abs(radius(p, c) - r));
     CHECK(worst < 0.5 * voxel);
@@ -76,7 +76,7 @@ TEST_CASE("level_set: box volume within 1% and surface within half a voxel") {
     const LevelSet ls = meshToLevelSet(box, {}, RunContext::silent());
     const double analyticVolume = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
     const TriMesh mesh = levelSetToMesh(ls, {}, RunContext::silent());
-    CHECK(std::abs(test::signedVolume(mesh) / analyticVolume - 1) < 0.01);
+    CHECK(std::abs(signedVolume(mesh) / analyticVolume - 1) < 0.01);
     double worst = 0;
     for (const Vec3f& p : mesh.positions) worst = std::max(worst, boxSurfaceDistance(p, lo, hi));
     CHECK(worst < 0.5 * ls.info().voxelMm);
@@ -97,7 +97,7 @@ TEST_CASE("level_set: meshing gives a closed, outward, consistently oriented sur
         CHECK(edges.nonManifoldEdges == 0);
         CHECK(edges.misorientedEdges == 0);
         CHECK(edges.components == 1);
-        CHECK(test::signedVolume(mesh) > 0);
+        CHECK(signedVolume(mesh) > 0);
     }
     LevelSetToMeshOptions adaptive;
     adaptive.adaptivity = 0.5;

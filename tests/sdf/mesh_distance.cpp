@@ -182,13 +182,6 @@ std::vector<double> distancesTo(const MeshDistance& mesh, const std::vector<Vec3
     return d;
 }
 
-double signedVolume(const TriMesh& mesh) {
-    double v6 = 0;
-    for (const Triangle& t : mesh.triangles)
-        v6 += dot(toD(mesh.positions[t[0]]), cross(toD(mesh.positions[t[1]]), toD(mesh.positions[t[2]])));
-    return v6 / 6;
-}
-
 EdgeReport edgeReport(const TriMesh& mesh) {
     EdgeReport report;
     // Every directed edge as (undirected key, forward?, triangle), sorted so equal keys are adjacent.

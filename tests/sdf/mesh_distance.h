@@ -37,8 +37,6 @@ double quantile(std::vector<double> values, double q);
 /// Distances from each of @p points to @p mesh.
 std::vector<double> distancesTo(const MeshDistance& mesh, const std::vector<Vec3d>& points);
 
-/// Signed volume by the divergence theorem (> 0 for a closed outward mesh), in units³.
-double signedVolume(const TriMesh& mesh);
 
 /// Edge topology of a triangle mesh.
 struct EdgeReport {

@@ -36,7 +36,7 @@ ShellParts splitShell(const TriMesh& shell) {
     double best = -1e300;
     uint32_t outerId = 0;
     for (uint32_t c = 0; c < parts.edges.components; ++c) {
-        const double v = test::signedVolume(test::extractComponent(shell, parts.edges, c));
+        const double v = signedVolume(test::extractComponent(shell, parts.edges, c));
         if (v > best) best = v, outerId = c;
     }
     parts.outer = test::extractComponent(shell, parts.edges, outerId);
@@ -69,8 +69,8 @@ TEST_CASE("shell: a sphere's shell is two closed walls shellMm apart") {
     CHECK(parts.edges.misorientedEdges == 0);
     // The outer wall faces out, the inner wall faces the cavity (negative volume).
     const double ri = r - 16.0;
-    CHECK(std::abs(test::signedVolume(parts.outer) / (4.0 / 3.0 * kPi * r * r * r) - 1) < 0.01);
-    CHECK(std::abs(-test::signedVolume(parts.inner) / (4.0 / 3.0 * kPi * ri * ri * ri) - 1) < 0.01);
+    CHECK(std::abs(signedVolume(parts.outer) / (4.0 / 3.0 * kPi * r * r * r) - 1) < 0.01);
+    CHECK(std::abs(-signedVolume(parts.inner) / (4.0 / 3.0 * kPi * ri * ri * ri) - 1) < 0.01);
 
     // Thickness measured on the result: outer samples to the inner wall.
     const test::MeshDistance inner(parts.inner);
@@ -133,7 +133,7 @@ TEST_CASE("shell: a thin object gives a solid piece where it is thinner than two
     const TriMesh mesh =
         levelSetToMesh(makeShell(object, shell, RunContext::silent()), {}, RunContext::silent());
     CHECK(test::edgeReport(mesh).components == 1);
-    CHECK(std::abs(test::signedVolume(mesh) / (40.0 * 40.0 * 6.0) - 1) < 0.02);
+    CHECK(std::abs(signedVolume(mesh) / (40.0 * 40.0 * 6.0) - 1) < 0.02);
 }
 
 TEST_CASE("round trip: bunny at 400 mm, two-sided Hausdorff 95th percentile <= 0.5 mm") {

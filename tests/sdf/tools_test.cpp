@@ -39,7 +39,7 @@ TEST_CASE("tools: zf-sdf | zf-shell | zf-mesh through pipes gives the closed she
     CHECK(edges.boundaryEdges == 0);
     CHECK(edges.misorientedEdges == 0);
     CHECK(edges.components == 2);  // outer wall and cavity
-    CHECK(test::signedVolume(result) > 0);
+    CHECK(signedVolume(result) > 0);
 
     // The grids carry where they came from.
     const auto grids = sdf::parseVdb(test::readFile(dir.file("shell.vdb")), "shell.vdb", RunContext::silent());

@@ -18,4 +18,12 @@ std::string formatNumbers(const char* pattern, Numbers... numbers) {
     return text;
 }
 
+/// @p value as printf's "%.<precision>g", which is also what an ostream prints at that precision:
+/// "16", "0.15", "1e+06". The one single-number formatter of the library.
+inline std::string formatNumber(double value, int precision = 6) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.*g", precision, value);
+    return text;
+}
+
 }  // namespace zomefab

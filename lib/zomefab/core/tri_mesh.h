@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace zomefab {
@@ -45,5 +46,27 @@ Box3d boundingBox(const TriMesh& mesh);
 /// Merges vertices with bit-identical coordinates (−0 = +0) into one, in first-seen order, and
 /// renumbers the triangles. Triangles are kept as they are, including any that now repeat a vertex.
 void weldIdenticalVertices(TriMesh& mesh);
+
+/// Signed volume of the closed, oriented surface made of @p triangles (divergence theorem), each
+/// corner taken relative to @p origin so that the sum stays well conditioned far from the
+/// coordinate origin. Cubed mesh units (mm³ after scaling); > 0 for an outward surface.
+double signedVolume(const TriMesh& mesh, const std::vector<uint32_t>& triangles, const Vec3d& origin);
+/// The same over every triangle.
+double signedVolume(const TriMesh& mesh, const Vec3d& origin = {0, 0, 0});
+
+/// The vertex-connected components of a mesh (triangles sharing a vertex are connected).
+struct VertexComponents {
+    std::vector<uint32_t> rootOf;  ///< per vertex: the smallest vertex index of its component
+    /// Indexed by root: the component's signed volume, corners relative to the root's position.
+    std::vector<double> volume;
+};
+VertexComponents vertexComponents(const TriMesh& mesh);
+
+/// Keeps the triangles of the components whose root passes @p isKept, in their order; the kept
+/// vertices are renumbered in order of first use and salientFaces follow their triangles. The one
+/// component filter of the library (specks left by a mesher, sealed cavities). Returns how many
+/// components were dropped.
+size_t keepComponents(TriMesh& mesh, const VertexComponents& components,
+                      const std::function<bool(uint32_t root)>& isKept);
 
 }  // namespace zomefab

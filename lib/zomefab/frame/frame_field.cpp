@@ -4,11 +4,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "zomefab/core/vec.h"
+
 namespace zomefab::frame {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
-double length(const Vec3d& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 }  // namespace
 
 Transform4d rotationAboutZ(double degrees) {
@@ -34,7 +35,7 @@ FrameField::FrameField(const sdf::InteriorField& field, double rotationDeg,
 bool FrameField::isSegmentAllowed(const Vec3d& p, double dp, const Vec3d& q, double dq,
                                   double limitMm) const {
     if (dp < limitMm || dq < limitMm) return false;
-    const double len = length({q[0] - p[0], q[1] - p[1], q[2] - p[2]});
+    const double len = norm({q[0] - p[0], q[1] - p[1], q[2] - p[2]});
     // Lipschitz: depth(x) ≥ max(dp − |x−p|, dq − |x−q|) ≥ (dp + dq − len)/2 on the segment.
     if (0.5 * (dp + dq - len) >= limitMm || len < 1.0) return true;
     const Vec3d m{0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1]), 0.5 * (p[2] + q[2])};
@@ -58,7 +59,7 @@ std::vector<SurfaceSample> sampleSurface(const FrameField& frameField, double sp
                               box.min[2] + k * spacingMm};
                 const sdf::FieldSample s = field.sample(p);
                 if (!(std::abs(s.signedDistanceMm) < 0.5 * spacingMm)) continue;
-                const double g = length(s.gradient);
+                const double g = norm(s.gradient);
                 if (!(g > 1e-9)) continue;
                 const Vec3d nrm{s.gradient[0] / g, s.gradient[1] / g, s.gradient[2] / g};
                 const Vec3d onSurface{p[0] - s.signedDistanceMm * nrm[0],

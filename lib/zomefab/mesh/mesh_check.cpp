@@ -8,36 +8,14 @@
 #include <numeric>
 #include <vector>
 
+#include "zomefab/core/disjoint_sets.h"
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
+#include "zomefab/core/vec.h"
 
 namespace zomefab::mesh {
 
 namespace {
-
-/// Union-find with path halving; deterministic (the smaller index becomes the root).
-class DisjointSets {
-public:
-    explicit DisjointSets(size_t n) : mParent(n) { std::iota(mParent.begin(), mParent.end(), uint32_t(0)); }
-    uint32_t find(uint32_t x) {
-        while (mParent[x] != x) x = mParent[x] = mParent[mParent[x]];
-        return x;
-    }
-    void unite(uint32_t a, uint32_t b) {
-        a = find(a), b = find(b);
-        if (a != b) mParent[std::max(a, b)] = std::min(a, b);
-    }
-
-private:
-    std::vector<uint32_t> mParent;
-};
-
-Vec3d toDouble(const Vec3f& p) { return {p[0], p[1], p[2]}; }
-Vec3d sub(const Vec3d& a, const Vec3d& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3d cross(const Vec3d& a, const Vec3d& b) {
-    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double norm(const Vec3d& a) { return std::sqrt(dot(a, a)); }
 
 /// One use of an undirected edge by a triangle.
 struct EdgeUse {
@@ -87,30 +65,10 @@ void checkIndices(const TriMesh& mesh) {
                                                          std::to_string(mesh.positions.size()) + " vertices");
 }
 
-std::string formatNumber(double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof(buf), "%.4g", x);
-    return buf;
-}
-
 std::string formatPoint(const Vec3d& p) {
     char buf[96];
     std::snprintf(buf, sizeof(buf), "(%.4g, %.4g, %.4g)", p[0], p[1], p[2]);
     return buf;
-}
-
-/// Signed volume of a closed oriented surface (divergence theorem), relative to @p origin to keep
-/// the sum well conditioned far from the coordinate origin.
-double signedVolume(const TriMesh& mesh, const std::vector<uint32_t>& triangles, const Vec3d& origin) {
-    double sum = 0;
-    for (uint32_t t : triangles) {
-        const Triangle& tri = mesh.triangles[t];
-        const Vec3d a = sub(toDouble(mesh.positions[tri[0]]), origin);
-        const Vec3d b = sub(toDouble(mesh.positions[tri[1]]), origin);
-        const Vec3d c = sub(toDouble(mesh.positions[tri[2]]), origin);
-        sum += dot(a, cross(b, c));
-    }
-    return sum / 6.0;
 }
 
 /// Generalised winding number of @p triangles at @p p (Van Oosterom & Strackee solid angles):
@@ -119,9 +77,9 @@ double windingNumber(const TriMesh& mesh, const std::vector<uint32_t>& triangles
     double sum = 0;
     for (uint32_t t : triangles) {
         const Triangle& tri = mesh.triangles[t];
-        const Vec3d a = sub(toDouble(mesh.positions[tri[0]]), p);
-        const Vec3d b = sub(toDouble(mesh.positions[tri[1]]), p);
-        const Vec3d c = sub(toDouble(mesh.positions[tri[2]]), p);
+        const Vec3d a = sub(toD(mesh.positions[tri[0]]), p);
+        const Vec3d b = sub(toD(mesh.positions[tri[1]]), p);
+        const Vec3d c = sub(toD(mesh.positions[tri[2]]), p);
         const double la = norm(a), lb = norm(b), lc = norm(c);
         const double num = dot(a, cross(b, c));
         const double den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
@@ -131,8 +89,8 @@ double windingNumber(const TriMesh& mesh, const std::vector<uint32_t>& triangles
 }
 
 double triangleArea(const TriMesh& mesh, uint32_t a, uint32_t b, uint32_t c) {
-    const Vec3d pa = toDouble(mesh.positions[a]);
-    return 0.5 * norm(cross(sub(toDouble(mesh.positions[b]), pa), sub(toDouble(mesh.positions[c]), pa)));
+    const Vec3d pa = toD(mesh.positions[a]);
+    return 0.5 * norm(cross(sub(toD(mesh.positions[b]), pa), sub(toD(mesh.positions[c]), pa)));
 }
 
 /// Minimum-area triangulation of the closed polygon @p loop (dynamic programming over sub-chains,
@@ -240,7 +198,7 @@ MeshReport checkMesh(const TriMesh& mesh) {
     r.triangleCount = mesh.triangles.size();
     for (const Vec3f& p : mesh.positions) {
         if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))
-            r.bounds.expand(toDouble(p));
+            r.bounds.expand(toD(p));
         else
             ++r.nonFiniteVertices;
     }
@@ -257,8 +215,8 @@ MeshReport checkMesh(const TriMesh& mesh) {
     sortedTriangles.reserve(mesh.triangles.size());
     for (const Triangle& t : mesh.triangles) {
         for (uint32_t v : t) used[v] = 1;
-        const Vec3d a = toDouble(mesh.positions[t[0]]), b = toDouble(mesh.positions[t[1]]),
-                    c = toDouble(mesh.positions[t[2]]);
+        const Vec3d a = toD(mesh.positions[t[0]]), b = toD(mesh.positions[t[1]]),
+                    c = toD(mesh.positions[t[2]]);
         const double twiceArea = norm(cross(sub(b, a), sub(c, a)));
         r.area += 0.5 * twiceArea;
         const double longest =
@@ -283,14 +241,14 @@ MeshReport checkMesh(const TriMesh& mesh) {
         for (size_t k = 1; k < count; ++k) triangleSets.unite(uses[first].triangle, uses[first + k].triangle);
         if (count == 1) {
             ++r.boundaryEdges;
-            r.boundaryBounds.expand(toDouble(mesh.positions[a]));
-            r.boundaryBounds.expand(toDouble(mesh.positions[b]));
+            r.boundaryBounds.expand(toD(mesh.positions[a]));
+            r.boundaryBounds.expand(toD(mesh.positions[b]));
             boundarySets.unite(a, b);
             onBoundary[a] = onBoundary[b] = 1;
         } else if (count >= 3) {
             ++r.nonManifoldEdges;
-            r.nonManifoldBounds.expand(toDouble(mesh.positions[a]));
-            r.nonManifoldBounds.expand(toDouble(mesh.positions[b]));
+            r.nonManifoldBounds.expand(toD(mesh.positions[a]));
+            r.nonManifoldBounds.expand(toD(mesh.positions[b]));
         } else if (uses[first].forward == uses[first + 1].forward) {
             ++r.inconsistentEdges;
         }
@@ -404,14 +362,14 @@ TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const s
             const uint32_t a = uint32_t(uses[first].key >> 32), b = uint32_t(uses[first].key & 0xffffffffu);
             if (count == 1) {
                 ++boundary;
-                boundaryBox.expand(toDouble(mesh.positions[a]));
-                boundaryBox.expand(toDouble(mesh.positions[b]));
+                boundaryBox.expand(toD(mesh.positions[a]));
+                boundaryBox.expand(toD(mesh.positions[b]));
                 loops.unite(a, b);
                 onBoundary[a] = onBoundary[b] = 1;
             } else if (count >= 3) {
                 ++nonManifold;
-                nonManifoldBox.expand(toDouble(mesh.positions[a]));
-                nonManifoldBox.expand(toDouble(mesh.positions[b]));
+                nonManifoldBox.expand(toD(mesh.positions[a]));
+                nonManifoldBox.expand(toD(mesh.positions[b]));
             }
         });
         if (boundary > 0) {
@@ -507,7 +465,7 @@ TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const s
         volumes.push_back(signedVolume(mesh, component, centre));
         Box3d b;
         for (uint32_t t : component)
-            for (uint32_t v : mesh.triangles[t]) b.expand(toDouble(mesh.positions[v]));
+            for (uint32_t v : mesh.triangles[t]) b.expand(toD(mesh.positions[v]));
         boxes.push_back(b);
     }
     // Nesting depth of each component: how many others contain a point of it (generalised winding
@@ -564,47 +522,19 @@ TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const s
     const double diagonal = std::sqrt(dot(size, size));
     if (!(volume > options.minRelativeVolume * diagonal * diagonal * diagonal))
         fail("zero volume: the closed surface encloses no space (flat or self-cancelling): volume " +
-             formatNumber(volume) + " for a bounding-box diagonal of " + formatNumber(diagonal));
+             formatNumber(volume, 4) + " for a bounding-box diagonal of " + formatNumber(diagonal, 4));
     return mesh;
 }
 
 CavityRemoval removeCavities(TriMesh& mesh, double maxVolumeMm3) {
-    DisjointSets sets(mesh.vertexCount());
-    for (const Triangle& t : mesh.triangles) sets.unite(t[0], t[1]), sets.unite(t[1], t[2]);
-    // Volumes about the bounding-box centre, to keep the sums well conditioned far from the origin.
-    const Box3d box = boundingBox(mesh);
-    const Vec3d centre{(box.min[0] + box.max[0]) / 2, (box.min[1] + box.max[1]) / 2, (box.min[2] + box.max[2]) / 2};
-    std::vector<double> volume(mesh.vertexCount(), 0.0);  // indexed by the component's root vertex
-    for (const Triangle& t : mesh.triangles) {
-        const Vec3d a = sub(toDouble(mesh.positions[t[0]]), centre);
-        const Vec3d b = sub(toDouble(mesh.positions[t[1]]), centre);
-        const Vec3d c = sub(toDouble(mesh.positions[t[2]]), centre);
-        volume[sets.find(t[0])] += dot(a, cross(b, c)) / 6.0;
-    }
-    auto isSmallCavity = [&](uint32_t root) { return volume[root] < 0.0 && -volume[root] <= maxVolumeMm3; };
+    const VertexComponents components = vertexComponents(mesh);
+    auto isSmallCavity = [&](uint32_t root) {
+        return components.volume[root] < 0.0 && -components.volume[root] <= maxVolumeMm3;
+    };
     CavityRemoval removal;
     for (uint32_t v = 0; v < mesh.vertexCount(); ++v)
-        if (sets.find(v) == v && isSmallCavity(v)) ++removal.cavities, removal.volumeMm3 -= volume[v];
-    if (removal.cavities == 0) return removal;
-
-    TriMesh kept;
-    std::vector<uint32_t> newIndex(mesh.vertexCount(), UINT32_MAX);
-    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
-        const Triangle& t = mesh.triangles[i];
-        if (isSmallCavity(sets.find(t[0]))) continue;
-        Triangle out;
-        for (int c = 0; c < 3; ++c) {
-            uint32_t& index = newIndex[t[size_t(c)]];
-            if (index == UINT32_MAX) {
-                index = uint32_t(kept.positions.size());
-                kept.positions.push_back(mesh.positions[t[size_t(c)]]);
-            }
-            out[size_t(c)] = index;
-        }
-        kept.triangles.push_back(out);
-        if (!mesh.salientFaces.empty()) kept.salientFaces.push_back(mesh.salientFaces[i]);
-    }
-    mesh = std::move(kept);
+        if (components.rootOf[v] == v && isSmallCavity(v)) ++removal.cavities, removal.volumeMm3 -= components.volume[v];
+    if (removal.cavities > 0) keepComponents(mesh, components, [&](uint32_t root) { return !isSmallCavity(root); });
     return removal;
 }
 

@@ -6,28 +6,19 @@
 #include <string>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 
 namespace zomefab::mesh {
-
-namespace {
-
-std::string formatValue(double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof(buf), "%g", x);
-    return buf;
-}
-
-}  // namespace
 
 void checkScaleOptions(const ScaleOptions& options) {
     if (options.heightMm && options.scale)
         throw Error(ErrorCode::Usage, "give either --height-mm or --scale, not both");
     if (options.heightMm && !(std::isfinite(*options.heightMm) && *options.heightMm > 0))
         throw Error(ErrorCode::Usage, "--height-mm must be a positive number of millimetres, got " +
-                                          formatValue(*options.heightMm));
+                                          formatNumber(*options.heightMm));
     if (options.scale && !(std::isfinite(*options.scale) && *options.scale > 0))
         throw Error(ErrorCode::Usage,
-                    "--scale must be a positive factor, got " + formatValue(*options.scale));
+                    "--scale must be a positive factor, got " + formatNumber(*options.scale));
 }
 
 ScaledMesh scaleToMillimetres(TriMesh mesh, const ScaleOptions& options) {
@@ -63,7 +54,7 @@ ScaledMesh scaleToMillimetres(TriMesh mesh, const ScaleOptions& options) {
     for (const Vec3f& p : mesh.positions)
         if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
             throw Error(ErrorCode::InvalidInput,
-                        "scaled coordinates overflow single precision (scale " + formatValue(scale) + ")");
+                        "scaled coordinates overflow single precision (scale " + formatNumber(scale) + ")");
     result.sizeMm = boundingBox(mesh).size();
     result.mesh = std::move(mesh);
     result.transformMm = transform;

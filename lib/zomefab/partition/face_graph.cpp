@@ -10,14 +10,9 @@
 #include <utility>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/vec.h"
 
 namespace zomefab::partition {
-
-namespace {
-
-Vec3d toD(const Vec3f& p) { return {double(p[0]), double(p[1]), double(p[2])}; }
-
-}  // namespace
 
 FaceGraph buildFaceGraph(const TriMesh& meshMm) {
     const size_t faceCount = meshMm.triangles.size();

@@ -12,8 +12,10 @@
 #include <set>
 #include <string>
 
+#include "zomefab/core/disjoint_sets.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
+#include "zomefab/core/vec.h"
 #include "zomefab/partition/alpha_expansion.h"
 #include "zomefab/partition/face_graph.h"
 
@@ -24,19 +26,10 @@ namespace {
 constexpr uint32_t kNone = 0xFFFFFFFFu;
 const double kPi = std::acos(-1.0);
 
-double dist2(const Vec3d& a, const Vec3d& b) {
-    const double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
-    return x * x + y * y + z * z;
-}
-
-Vec3d toD(const Vec3f& p) { return {double(p[0]), double(p[1]), double(p[2])}; }
-
 std::string sizeText(const Vec3d& v) { return formatNumbers("%.0f x %.0f x %.0f mm", v[0], v[1], v[2]); }
 
 /// Closest point of triangle abc to p, squared distance (Ericson, Real-Time Collision Detection §5.1.5).
 double pointTriangleDist2(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
-    auto sub = [](const Vec3d& x, const Vec3d& y) { return Vec3d{x[0] - y[0], x[1] - y[1], x[2] - y[2]}; };
-    auto dot = [](const Vec3d& x, const Vec3d& y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
     auto at = [&](const Vec3d& o, const Vec3d& u, double s, const Vec3d& v, double t) {
         return Vec3d{o[0] + s * u[0] + t * v[0], o[1] + s * u[1] + t * v[1], o[2] + s * u[2] + t * v[2]};
     };
@@ -318,23 +311,6 @@ double sharedEdgeMm(const TriMesh& mesh, uint32_t f, uint32_t h) {
     return n >= 2 ? std::sqrt(dist2(toD(mesh.positions[shared[0]]), toD(mesh.positions[shared[1]]))) : 0.0;
 }
 
-/// Union-find over pieces.
-struct Dsu {
-    std::vector<uint32_t> parent;
-    explicit Dsu(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-    uint32_t find(uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    }
-    /// Joins into the smaller root id (keeps numbering deterministic).
-    void join(uint32_t a, uint32_t b) {
-        a = find(a), b = find(b);
-        if (a == b) return;
-        if (b < a) std::swap(a, b);
-        parent[b] = a;
-    }
-};
-
 }  // namespace
 
 // --- public helpers ---------------------------------------------------------------------------
@@ -425,7 +401,7 @@ RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph, c
             if (regionOf[h] != regionOf[f]) seam[regionOf[f]][regionOf[h]] += sharedEdgeMm(meshMm, f, h);
         }
     }
-    Dsu dsu(regionCount);
+    DisjointSets dsu(regionCount);
     std::vector<char> isRoot(regionCount, 1);
     // Pairs (lower root, higher root) whose union was tested and does not fit. A pair is tested
     // again only after one of its regions grew (its entries are dropped then).
@@ -465,7 +441,7 @@ RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph, c
             }
             if (into == kNone) continue;
             // Merge r and into; the lower id stays the root.
-            dsu.join(r, into);
+            dsu.unite(r, into);
             const uint32_t root = dsu.find(r), gone = root == r ? into : r;
             isRoot[gone] = 0;
             area[root] += area[gone];
@@ -1140,7 +1116,7 @@ private:
         std::vector<double> fragArea(fragCount, 0.0);
         for (uint32_t f = 0; f < mFaceCount; ++f) fragArea[fragOf[f]] += mGraph.areasMm2[f];
 
-        Dsu dsu(fragCount);
+        DisjointSets dsu(fragCount);
         std::vector<std::vector<uint32_t>> members(fragCount);  // faces of each root
         for (uint32_t c = 0; c < fragCount; ++c)
             members[c].assign(fragFaces.begin() + fragOffsets[c], fragFaces.begin() + fragOffsets[c + 1]);
@@ -1154,7 +1130,7 @@ private:
         };
         // Makes roots a and b one piece whose faces are @p joined.
         auto unite = [&](uint32_t a, uint32_t b, std::vector<uint32_t> joined) {
-            dsu.join(a, b);
+            dsu.unite(a, b);
             const uint32_t root = dsu.find(a), other = root == a ? b : a;
             members[root] = std::move(joined);
             members[other].clear();
@@ -1190,8 +1166,8 @@ private:
                     const uint32_t a = fragOf[f], b = fragOf[mGraph.neighbors[i]];
                     if (a < b && fragGroup[a] == fragGroup[b]) touching.insert({a, b});
                 }
-            Dsu linked(fragCount);
-            for (const auto& [a, b] : touching) linked.join(a, b);
+            DisjointSets linked(fragCount);
+            for (const auto& [a, b] : touching) linked.unite(a, b);
             std::vector<std::vector<uint32_t>> setFaces(fragCount);
             for (uint32_t f = 0; f < mFaceCount; ++f) setFaces[linked.find(fragOf[f])].push_back(f);
             std::vector<uint32_t> setRoots;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "zomefab/core/json_values.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/version.h"
 
@@ -13,7 +14,6 @@ using nlohmann::json;
 
 namespace {
 
-json vec(const Vec3d& v) { return json::array({v[0], v[1], v[2]}); }
 
 template <class T>
 void append(std::string& out, T value) {
@@ -31,12 +31,8 @@ json partitionToJson(const PartitionResult& r, const PartitionOptions& o, const 
     j["generator"] = generatorString();
     j["mesh"] = {{"file", info.meshFile}, {"faces", r.faceCells.size()}, {"vertices", info.vertexCount}};
     j["frame"] = {{"file", info.frameFile}, {"b0_mm", r.b0Mm}};
-    json t = json::array();
-    for (int row = 0; row < 4; ++row)
-        t.push_back({info.transformMm.at(row, 0), info.transformMm.at(row, 1), info.transformMm.at(row, 2),
-                     info.transformMm.at(row, 3)});
-    j["transform_mm"] = t;
-    j["printer_mm"] = vec(r.printerMm);
+    j["transform_mm"] = toJson(info.transformMm);
+    j["printer_mm"] = toJson(r.printerMm);
     j["fit_margin_mm"] = r.fitMarginMm;
 
     json labels = json::array();
@@ -45,25 +41,25 @@ json partitionToJson(const PartitionResult& r, const PartitionOptions& o, const 
 
     json cells = json::array();
     for (size_t c = 0; c < r.cells.cellCount(); ++c)
-        cells.push_back({{"cell", c}, {"ball", r.cellBalls[c]}, {"w", vec(r.cells.w[c])}, {"b", r.cells.b[c]}});
+        cells.push_back({{"cell", c}, {"ball", r.cellBalls[c]}, {"w", toJson(r.cells.w[c])}, {"b", r.cells.b[c]}});
     j["cells"] = cells;
 
     json pieces = json::array();
     for (size_t p = 0; p < r.pieces.size(); ++p) {
         const Piece& piece = r.pieces[p];
-        json axes = json::array({vec(piece.fit.axes[0]), vec(piece.fit.axes[1]), vec(piece.fit.axes[2])});
+        json axes = json::array({toJson(piece.fit.axes[0]), toJson(piece.fit.axes[1]), toJson(piece.fit.axes[2])});
         pieces.push_back({{"piece", p},
                           {"cells", piece.cells},
                           {"balls", piece.balls},
                           {"faces", piece.faceCount},
                           {"area_mm2", piece.areaMm2},
-                          {"bbox_mm", {{"min", vec(piece.boundsMm.min)}, {"max", vec(piece.boundsMm.max)}}},
+                          {"bbox_mm", {{"min", toJson(piece.boundsMm.min)}, {"max", toJson(piece.boundsMm.max)}}},
                           {"fit",
                            {{"fits", piece.fit.fits},
                             {"ratio", piece.fit.ratio},
                             {"axes", axes},
-                            {"extents_mm", vec(piece.fit.extentsMm)},
-                            {"center_mm", vec(piece.fit.centerMm)}}}});
+                            {"extents_mm", toJson(piece.fit.extentsMm)},
+                            {"center_mm", toJson(piece.fit.centerMm)}}}});
     }
     j["pieces"] = pieces;
 

@@ -7,7 +7,9 @@
 #include <sstream>
 
 #include "zomefab/core/error.h"
-#include "zomefab/pieces/detail/vec.h"
+#include "zomefab/core/format.h"
+#include "zomefab/core/vec.h"
+#include "zomefab/pieces/detail/box_distance.h"
 #include "zomefab/zome/zome_system.h"
 
 namespace zomefab::pieces {
@@ -26,19 +28,13 @@ constexpr double kAboveSurfaceMm = 2.0;
 double digitWidthMm(const LabelOptions& o) { return std::max(0.55 * o.heightMm, 3.0 * o.strokeMm); }
 double digitGapMm(const LabelOptions& o) { return std::max(0.3 * o.heightMm, 1.5 * o.strokeMm); }
 
-std::string number(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
-
 }  // namespace
 
 void checkLabelOptions(const LabelOptions& o) {
     auto require = [](double v, double lo, double hi, const char* what) {
         if (!(v >= lo && v <= hi))
-            throw Error(ErrorCode::Usage, std::string(what) + " must be in [" + number(lo) + ", " + number(hi) +
-                                              "] mm, got " + number(v));
+            throw Error(ErrorCode::Usage, std::string(what) + " must be in [" + formatNumber(lo) + ", " + formatNumber(hi) +
+                                              "] mm, got " + formatNumber(v));
     };
     require(o.heightMm, 3.0, 50.0, "the label height");
     require(o.strokeMm, 0.5, o.heightMm / 3.0, "the label stroke");

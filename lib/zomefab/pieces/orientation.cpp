@@ -7,7 +7,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "zomefab/pieces/detail/vec.h"
+#include "zomefab/core/vec.h"
+#include "zomefab/pieces/detail/box_distance.h"
 
 namespace zomefab::pieces {
 
@@ -104,7 +105,6 @@ Candidate evaluate(const std::vector<Vec3d>& points, const Vec3d& down, const Ve
     c.placement = bestTurn(convexHull(std::move(projected)), z1 - z0, printer);
     return c;
 }
-
 
 /// The mesh in double precision, with each triangle's vector area (area × unit outward normal).
 struct MeshD {

@@ -24,11 +24,15 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "zomefab/core/error.h"
-#include "zomefab/mesh/mesh_check.h"
-#include "zomefab/pieces/detail/vec.h"
-#include "zomefab/pieces/orientation.h"
 #include "zomefab/pieces/pieces.h"
+
+#include "zomefab/core/disjoint_sets.h"
+#include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
+#include "zomefab/core/vec.h"
+#include "zomefab/mesh/mesh_check.h"
+#include "zomefab/pieces/detail/box_distance.h"
+#include "zomefab/pieces/orientation.h"
 #include "zomefab/sdf/level_set_grid.h"
 
 namespace zomefab::pieces {
@@ -43,13 +47,6 @@ namespace {
 
 constexpr uint32_t kNone = 0xFFFFFFFFu;
 constexpr uint32_t kLeafSize = 512;  // 8³ voxels per leaf node
-
-std::string number(double v, int precision = 4) {
-    std::ostringstream s;
-    s.precision(precision);
-    s << v;
-    return s.str();
-}
 
 // --- cells in the grid's millimetres --------------------------------------------------------------
 
@@ -216,27 +213,6 @@ VoxelField buildField(const FloatGrid& shell) {
     return f;
 }
 
-/// Disjoint sets with the smallest element as root (deterministic).
-struct DisjointSets {
-    std::vector<uint32_t> parent;
-    explicit DisjointSets(size_t n = 0) : parent(n) {
-        for (size_t i = 0; i < n; ++i) parent[i] = uint32_t(i);
-    }
-    uint32_t find(uint32_t x) {
-        while (parent[x] != x) {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        return x;
-    }
-    void unite(uint32_t a, uint32_t b) {
-        a = find(a), b = find(b);
-        if (a == b) return;
-        if (a < b) parent[b] = a;
-        else parent[a] = b;
-    }
-};
-
 /// Calls @p visit(slot, neighbourSlot) for the +x, +y, +z neighbour of every active slot.
 template <class Visit>
 void forEachForwardPair(const VoxelField& f, Visit&& visit) {
@@ -267,40 +243,8 @@ struct Component {
 /// Drops the vertex-connected components of @p mesh enclosing less than @p minVolumeMm3: specks
 /// the mesher leaves where the iso-surface grazes a voxel. Returns how many were dropped.
 size_t dropSpecks(TriMesh& mesh, double minVolumeMm3) {
-    const size_t nv = mesh.positions.size();
-    DisjointSets sets(nv);
-    for (const Triangle& t : mesh.triangles) {
-        sets.unite(t[0], t[1]);
-        sets.unite(t[0], t[2]);
-    }
-    std::vector<double> volume6(nv, 0.0);
-    for (const Triangle& t : mesh.triangles) {
-        const uint32_t root = sets.find(t[0]);
-        const Vec3d o = toD(mesh.positions[root]);  // well conditioned far from the origin
-        const Vec3d a = sub(toD(mesh.positions[t[0]]), o), b = sub(toD(mesh.positions[t[1]]), o),
-                    c = sub(toD(mesh.positions[t[2]]), o);
-        volume6[root] += dot(a, cross(b, c));
-    }
-    std::vector<Triangle> kept;
-    kept.reserve(mesh.triangles.size());
-    std::vector<uint8_t> isCounted(nv, 0);
-    size_t dropped = 0;
-    for (const Triangle& t : mesh.triangles) {
-        const uint32_t root = sets.find(t[0]);
-        if (std::abs(volume6[root]) / 6.0 >= minVolumeMm3) kept.push_back(t);
-        else if (!isCounted[root]) isCounted[root] = 1, ++dropped;
-    }
-    if (dropped == 0) return 0;
-    std::vector<uint32_t> index(nv, kNone);
-    std::vector<Vec3f> positions;
-    for (Triangle& t : kept)
-        for (uint32_t& v : t) {
-            if (index[v] == kNone) index[v] = uint32_t(positions.size()), positions.push_back(mesh.positions[v]);
-            v = index[v];
-        }
-    mesh.positions = std::move(positions);
-    mesh.triangles = std::move(kept);
-    return dropped;
+    const VertexComponents components = vertexComponents(mesh);
+    return keepComponents(mesh, components, [&](uint32_t root) { return std::abs(components.volume[root]) >= minVolumeMm3; });
 }
 
 /// A piece's grid → closed, outward triangles (quads split along the shorter diagonal), specks
@@ -361,9 +305,9 @@ void checkPiecesOptions(const PiecesOptions& o) {
         throw Error(ErrorCode::Usage, "the smallest piece volume must be a finite number ≥ 0 mm³");
     for (double p : o.printerMm)
         if (!(p >= 10.0 && p <= 10000.0))
-            throw Error(ErrorCode::Usage, "printer sizes must be in [10, 10000] mm, got " + number(p));
+            throw Error(ErrorCode::Usage, "printer sizes must be in [10, 10000] mm, got " + formatNumber(p, 4));
     if (!(o.adaptivity >= 0 && o.adaptivity <= 1))
-        throw Error(ErrorCode::Usage, "adaptivity must be in [0, 1], got " + number(o.adaptivity));
+        throw Error(ErrorCode::Usage, "adaptivity must be in [0, 1], got " + formatNumber(o.adaptivity, 4));
     checkTenonOptions(o.tenons);
     checkLabelOptions(o.label);
 }
@@ -390,12 +334,12 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
     const double voxel = shell->voxelSize()[0];
     PiecesOptions opt = options;
     if (opt.tenons.maxPerPiece > 0 && voxel > maxVoxelForPegsMm(opt.tenons))
-        throw Error(ErrorCode::Usage, "tenon pegs " + number(pegShortMm(opt.tenons)) + " mm thick need a voxel of at most " +
-                                          number(maxVoxelForPegsMm(opt.tenons)) + " mm, but the shell's voxel is " +
-                                          number(voxel) + " mm: rebuild it finer (zf-sdf --voxel-mm) or turn tenons off");
+        throw Error(ErrorCode::Usage, "tenon pegs " + formatNumber(pegShortMm(opt.tenons), 4) + " mm thick need a voxel of at most " +
+                                          formatNumber(maxVoxelForPegsMm(opt.tenons), 4) + " mm, but the shell's voxel is " +
+                                          formatNumber(voxel, 4) + " mm: rebuild it finer (zf-sdf --voxel-mm) or turn tenons off");
     if (opt.label.isEnabled && opt.label.strokeMm < 2.0 * voxel) {
-        context.warn("piece numbers are not engraved: a " + number(opt.label.strokeMm) + " mm stroke needs a voxel of at most " +
-                     number(opt.label.strokeMm / 2.0) + " mm (the shell's is " + number(voxel) + " mm)");
+        context.warn("piece numbers are not engraved: a " + formatNumber(opt.label.strokeMm, 4) + " mm stroke needs a voxel of at most " +
+                     formatNumber(opt.label.strokeMm / 2.0, 4) + " mm (the shell's is " + formatNumber(voxel, 4) + " mm)");
         opt.label.isEnabled = false;
     }
 
@@ -454,7 +398,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
         if (ca != cb) ++contacts[{std::min(ca, cb), std::max(ca, cb)}];
     });
     context.progress("pieces", 0.15);
-    context.debug(std::string("voxels, cells and components: ") + number(clock.seconds(), 3) + " s");
+    context.debug(std::string("voxels, cells and components: ") + formatNumber(clock.seconds(), 3) + " s");
     context.throwIfCancelled();
 
     // --- 2. components → pieces -------------------------------------------------------------
@@ -567,7 +511,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
         }
     }
     if (out.outsideCellsVolumeMm3 > 0)
-        context.warn(number(out.outsideCellsVolumeMm3) +
+        context.warn(formatNumber(out.outsideCellsVolumeMm3, 4) +
                      " mm³ of the shell lie in cells that no partition piece names; merged into their neighbours" +
                      (orphansKept ? " (" + std::to_string(orphansKept) + " with no neighbour kept as pieces)" : ""));
     for (uint32_t r0 : rootsByVolume()) {
@@ -577,7 +521,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
             ++out.sliversMerged;
         } else {
             ++out.isolatedSlivers;
-            context.warn("a " + number(rootVolume[root]) +
+            context.warn("a " + formatNumber(rootVolume[root], 4) +
                          " mm³ piece touches no other piece and cannot be merged: it is kept as it is");
         }
     }
@@ -681,7 +625,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
     context.info(std::to_string(pieceCount) + " pieces from " + std::to_string(comps.size()) + " components of " +
                  std::to_string(cellCount) + " cells (" + std::to_string(out.sliversMerged) + " slivers merged)");
     context.progress("pieces", 0.25);
-    context.debug(std::string("pieces: ") + number(clock.seconds(), 3) + " s");
+    context.debug(std::string("pieces: ") + formatNumber(clock.seconds(), 3) + " s");
     context.throwIfCancelled();
 
     // --- 3. tenons and labels, planned against the shell and the piece labels ------------------------
@@ -743,7 +687,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
                          " pieces have no engraved number (no flat inner spot clear of cuts and tenons)");
     }
     context.progress("pieces", 0.35);
-    context.debug(std::string("tenons and labels planned: ") + number(clock.seconds(), 3) + " s");
+    context.debug(std::string("tenons and labels planned: ") + formatNumber(clock.seconds(), 3) + " s");
     context.throwIfCancelled();
 
     // --- 4. per piece: level set by CSG, mesh, checks, orientation --------------------------------
@@ -853,7 +797,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
     });
     context.throwIfCancelled();
     context.progress("pieces", 0.5);
-    context.debug(std::string("level sets: ") + number(clock.seconds(), 3) + " s");
+    context.debug(std::string("level sets: ") + formatNumber(clock.seconds(), 3) + " s");
     field = VoxelField();
 
     // Meshing. Not OpenVDB's fracture scheme (VolumeToMesh::setRefGrid): it snaps the seam
@@ -873,7 +817,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
         }
     });
     context.throwIfCancelled();
-    context.debug("meshed: " + number(clock.seconds(), 3) + " s");
+    context.debug("meshed: " + formatNumber(clock.seconds(), 3) + " s");
 
     std::vector<std::string> orientationNotes(pieceCount);  // reported in piece order below
     tbb::parallel_for(tbb::blocked_range<size_t>(0, pieceCount, 1), [&](const tbb::blocked_range<size_t>& range) {
@@ -887,14 +831,14 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
             const mesh::CavityRemoval cavities = mesh::removeCavities(mesh, 1000.0 * voxel * voxel * voxel);
             if (cavities.cavities > 0)
                 context.debug("piece " + std::to_string(p) + ": filled " + std::to_string(cavities.cavities) +
-                              " sealed cavities of " + number(cavities.volumeMm3) + " mm³");
+                              " sealed cavities of " + formatNumber(cavities.volumeMm3, 4) + " mm³");
             const mesh::MeshReport report = mesh::checkMesh(mesh);
             if (report.boundaryEdges > 0 || report.nonManifoldEdges > 0 || !(report.volume > 0))
                 throw Error(ErrorCode::ProcessingFailed,
                             "piece " + std::to_string(p) + ": the mesh is not a closed, outward surface (" +
                                 std::to_string(report.boundaryEdges) + " boundary and " +
                                 std::to_string(report.nonManifoldEdges) + " non-manifold edges, volume " +
-                                number(report.volume) + " mm³)");
+                                formatNumber(report.volume, 4) + " mm³)");
             piece.volumeMm3 = report.volume;
             piece.gridBoundsMm = boundingBox(mesh);
 
@@ -913,9 +857,9 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
             if (!orientation.fits) {
                 const Vec3d e = orientation.extentsMm;
                 throw Error(ErrorCode::ProcessingFailed,
-                            "piece " + std::to_string(p) + " (" + number(e[0], 4) + " × " + number(e[1], 4) + " × " +
-                                number(e[2], 4) + " mm at best) fits the " + number(opt.printerMm[0]) + " × " +
-                                number(opt.printerMm[1]) + " × " + number(opt.printerMm[2]) +
+                            "piece " + std::to_string(p) + " (" + formatNumber(e[0], 4) + " × " + formatNumber(e[1], 4) + " × " +
+                                formatNumber(e[2], 4) + " mm at best) fits the " + formatNumber(opt.printerMm[0], 4) + " × " +
+                                formatNumber(opt.printerMm[1], 4) + " × " + formatNumber(opt.printerMm[2], 4) +
                                 " mm printer in no orientation: the partition must cut it smaller (zf-partition "
                                 "--printer-mm, --fit-margin-mm)");
             }
@@ -946,7 +890,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
         context.info(std::to_string(offCutFace) + " of " + std::to_string(pieceCount) +
                      " pieces have no cut face they can lie on; they rest on their largest base that fits");
     out.seconds = clock.seconds();
-    context.debug("meshed, checked and oriented: " + number(out.seconds, 3) + " s");
+    context.debug("meshed, checked and oriented: " + formatNumber(out.seconds, 3) + " s");
     return out;
 }
 

@@ -4,12 +4,14 @@
 
 #include <cmath>
 
+#include "zomefab/core/json_values.h"
 #include "zomefab/core/error.h"
+#include "zomefab/core/vec.h"
 #include "zomefab/core/version.h"
 #include "zomefab/io/file_io.h"
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/io/threemf.h"
-#include "zomefab/pieces/detail/vec.h"
+#include "zomefab/pieces/detail/box_distance.h"
 
 namespace zomefab::pieces {
 
@@ -17,13 +19,6 @@ using nlohmann::json;
 
 namespace {
 
-json vec(const Vec3d& v) { return json::array({v[0], v[1], v[2]}); }
-json box(const Box3d& b) { return {{"min", vec(b.min)}, {"max", vec(b.max)}}; }
-json matrix(const Transform4d& t) {
-    json rows = json::array();
-    for (int r = 0; r < 4; ++r) rows.push_back({t.at(r, 0), t.at(r, 1), t.at(r, 2), t.at(r, 3)});
-    return rows;
-}
 
 }  // namespace
 
@@ -45,10 +40,10 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
     j["generator"] = generatorString();
     j["units"] = "mm";
     j["inputs"] = {{"shell", info.shellFile}, {"frame", info.frameFile}, {"partition", info.partitionFile}};
-    j["printer_mm"] = vec(all.printerMm);
+    j["printer_mm"] = toJson(all.printerMm);
     j["voxel_mm"] = all.voxelMm;
-    j["grid_transform_mm"] = matrix(all.gridTransformMm);
-    j["frame_to_grid_mm"] = matrix(all.frameToGridMm);
+    j["grid_transform_mm"] = toJson(all.gridTransformMm);
+    j["frame_to_grid_mm"] = toJson(all.frameToGridMm);
     j["options"] = {{"min_piece_volume_mm3", o.minPieceVolumeMm3},
                     {"adaptivity", o.adaptivity},
                     {"tenons",
@@ -84,14 +79,14 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
         for (const Tenon& t : p.tenons) {
             tenons.push_back({{"ball", t.ball},
                               {"hole", t.hole},
-                              {"axis_frame", vec(t.axisFrame)},
-                              {"axis_mm", vec(t.axisGrid)},
-                              {"peg_long_side_mm", vec(t.longSideGrid)},
-                              {"ball_center_mm", vec(t.ballCenterGridMm)},
-                              {"peg_tip_mm", vec(t.pointAt(t.pegTipMm))},
-                              {"shoulder_mm", vec(t.pointAt(t.shoulderMm))},
-                              {"base_mm", vec(t.pointAt(t.baseMm))},
-                              {"end_mm", vec(t.pointAt(t.endMm))},
+                              {"axis_frame", toJson(t.axisFrame)},
+                              {"axis_mm", toJson(t.axisGrid)},
+                              {"peg_long_side_mm", toJson(t.longSideGrid)},
+                              {"ball_center_mm", toJson(t.ballCenterGridMm)},
+                              {"peg_tip_mm", toJson(t.pointAt(t.pegTipMm))},
+                              {"shoulder_mm", toJson(t.pointAt(t.shoulderMm))},
+                              {"base_mm", toJson(t.pointAt(t.baseMm))},
+                              {"end_mm", toJson(t.pointAt(t.endMm))},
                               {"length_mm", t.lengthMm()},
                               {"tilt_deg", t.tiltDeg}});
         }
@@ -103,9 +98,9 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
         json label = nullptr;
         if (p.label)
             label = {{"text", p.label->text},
-                     {"center_mm", vec(p.label->centerGridMm)},
-                     {"normal", vec(p.label->normalGrid)},
-                     {"up", vec(p.label->upGrid)},
+                     {"center_mm", toJson(p.label->centerGridMm)},
+                     {"normal", toJson(p.label->normalGrid)},
+                     {"up", toJson(p.label->upGrid)},
                      {"size_mm", {p.label->widthMm, p.label->heightMm}}};
         Box3d printed = boundingBox(p.mesh);
         pieces.push_back({{"piece", p.id},
@@ -113,14 +108,14 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                           {"volume_mm3", p.volumeMm3},
                           {"shell_volume_mm3", p.shellVolumeMm3},
                           {"triangles", p.mesh.triangles.size()},
-                          {"bbox_mm", box(printed)},
-                          {"grid_bbox_mm", box(p.gridBoundsMm)},
+                          {"bbox_mm", toJson(printed)},
+                          {"grid_bbox_mm", toJson(p.gridBoundsMm)},
                           {"orientation",
-                           {{"transform_mm", matrix(p.gridToPrintMm)},
+                           {{"transform_mm", toJson(p.gridToPrintMm)},
                             {"cut_face_down", p.isCutFaceDown},
-                            {"down_normal", vec(p.downNormalGridMm)},
+                            {"down_normal", toJson(p.downNormalGridMm)},
                             {"base_area_mm2", p.baseAreaMm2},
-                            {"extents_mm", vec(p.extentsMm)},
+                            {"extents_mm", toJson(p.extentsMm)},
                             {"fits", true}}},
                           {"cells", p.cells},
                           {"partition_pieces", p.requests},

@@ -8,7 +8,9 @@
 #include <sstream>
 
 #include "zomefab/core/error.h"
-#include "zomefab/pieces/detail/vec.h"
+#include "zomefab/core/format.h"
+#include "zomefab/core/vec.h"
+#include "zomefab/pieces/detail/box_distance.h"
 #include "zomefab/zome/zome_system.h"
 
 namespace zomefab::pieces {
@@ -44,16 +46,10 @@ std::vector<int> tenonHoles(const TenonOptions& o) {
 /// How far the peg reaches into the prism so that the union has no seam at the shoulder.
 constexpr double kPegOverlapMm = 0.5;
 
-std::string number(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
-
 void requireRange(double value, double lo, double hi, const char* name, const char* unit) {
     if (!(value >= lo && value <= hi))
-        throw Error(ErrorCode::Usage, std::string(name) + " must be in [" + number(lo) + ", " + number(hi) + "] " + unit +
-                                          ", got " + number(value));
+        throw Error(ErrorCode::Usage, std::string(name) + " must be in [" + formatNumber(lo) + ", " + formatNumber(hi) + "] " + unit +
+                                          ", got " + formatNumber(value));
 }
 
 /// Refines the first crossing φ < 0 on the ray between t0 (outside) and t1 (inside).
@@ -81,7 +77,7 @@ void checkTenonOptions(const TenonOptions& o) {
     requireRange(o.holeShortMm, 1.0, o.holeLongMm, "the hole's short side", "mm");
     if (pegShortMm(o) < 1.0)
         throw Error(ErrorCode::Usage, "the peg (hole less twice the clearance) must be at least 1 mm thick, got " +
-                                          number(pegShortMm(o)) + " mm");
+                                          formatNumber(pegShortMm(o)) + " mm");
     requireRange(o.pegDepthMm, 1.0, 8.0, "the peg depth", "mm");
     requireRange(o.bodyWidthMm, pegLongMm(o), 20.0, "the tenon width", "mm");
     requireRange(o.maxLengthMm, 1.0, 200.0, "the longest tenon", "mm");

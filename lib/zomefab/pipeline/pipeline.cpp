@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <functional>
 
+#include "zomefab/core/json_values.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
 #include "zomefab/core/version.h"
@@ -42,11 +43,6 @@ auto timedStage(const std::string& name, RunResult& result, RunContext& context,
     throw e.withFile(sourceName);
 }
 
-nlohmann::json transformJson(const Transform4d& t) {
-    nlohmann::json rows = nlohmann::json::array();
-    for (int r = 0; r < 4; ++r) rows.push_back({t.at(r, 0), t.at(r, 1), t.at(r, 2), t.at(r, 3)});
-    return rows;
-}
 
 }  // namespace
 
@@ -219,7 +215,7 @@ nlohmann::json runReportJson(const RunResult& result, const RunOptions& options,
                        {"triangles", result.inputReport.triangleCount},
                        {"vertices", result.inputReport.vertexCount},
                        {"size_mm", result.scaled.sizeMm},
-                       {"transform_mm", transformJson(result.scaled.transformMm)}};
+                       {"transform_mm", toJson(result.scaled.transformMm)}};
     report["level_sets"] = {
         {"object", {{"voxel_mm", result.field.object.info().voxelMm},
                     {"active_voxels", result.field.object.activeVoxelCount()}}},

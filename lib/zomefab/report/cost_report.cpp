@@ -74,8 +74,8 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piece
     report.source = options.source;
     report.parts = parts;
     report.pieceCount = piecesMm.size();
-    report.objectVolumeMm3 = meshVolumeMm3(objectMm);
-    for (const TriMesh& p : piecesMm) report.piecesVolumeMm3 += meshVolumeMm3(p);
+    report.objectVolumeMm3 = signedVolume(objectMm);
+    for (const TriMesh& p : piecesMm) report.piecesVolumeMm3 += signedVolume(p);
 
     context.progress("report", 0.0);
     const std::vector<TriMesh> baselineParts = octreeParts(objectMm, options.printerMm, 10, context);

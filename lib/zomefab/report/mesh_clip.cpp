@@ -321,16 +321,6 @@ TriMesh clipToBox(const TriMesh& mesh, const Box3d& box) {
     return part;
 }
 
-double meshVolumeMm3(const TriMesh& m) {
-    double v = 0.0;
-    for (const Triangle& t : m.triangles) {
-        const Vec3f &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
-        v += double(a[0]) * (double(b[1]) * c[2] - double(b[2]) * c[1]) -
-             double(a[1]) * (double(b[0]) * c[2] - double(b[2]) * c[0]) +
-             double(a[2]) * (double(b[0]) * c[1] - double(b[1]) * c[0]);
-    }
-    return v / 6.0;
-}
 
 double meshAreaMm2(const TriMesh& m) {
     double s = 0.0;

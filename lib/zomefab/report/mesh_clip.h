@@ -21,8 +21,7 @@ TriMesh clipByPlane(const TriMesh& mesh, int axis, double coordMm, bool keepBelo
 /// that the mesh does not cross). @throw as clipByPlane().
 TriMesh clipToBox(const TriMesh& mesh, const Box3d& box);
 
-/// Volume (mm³, divergence theorem; positive for a closed outward mesh) and area (mm²).
-double meshVolumeMm3(const TriMesh& mesh);
+/// Area (mm²).
 double meshAreaMm2(const TriMesh& mesh);
 
 }  // namespace zomefab::report

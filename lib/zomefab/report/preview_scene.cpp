@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/vec.h"
 #include "zomefab/core/version.h"
 #include "zomefab/zome/parts.h"
 
@@ -18,15 +19,6 @@ namespace zomefab::report {
 namespace {
 
 using Mat3 = std::array<Vec3d, 3>;  // columns
-
-double dot(const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec3d crossV(const Vec3d& a, const Vec3d& b) {
-    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-Vec3d normalized(const Vec3d& a) {
-    const double n = std::sqrt(dot(a, a));
-    return {a[0] / n, a[1] / n, a[2] / n};
-}
 
 /// sRGB component (0..1) to the linear value glTF's baseColorFactor expects (glTF 2.0 §3.9.2).
 double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
@@ -310,7 +302,7 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
                 node.name = "strut-" + std::to_string(id);
                 node.mesh = mesh;
                 node.translation = s.startMm;
-                node.rotation = quaternionFromColumns({u, crossV(d, u), d});
+                node.rotation = quaternionFromColumns({u, cross(d, u), d});
                 node.extras = {{"part", zome::partName(s.color, s.size)},
                                {"balls", {s.a, s.b}},
                                {"holes", {int(s.holeA), int(s.holeB)}}};

@@ -104,7 +104,7 @@ PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const P
         perimeterMm3 += area * wall;
         solidMm3 += area * std::max(0.0, skin - wall);
     }
-    const double volume = std::max(0.0, meshVolumeMm3(part));
+    const double volume = std::max(0.0, signedVolume(part));
     const double shell = perimeterMm3 + solidMm3;
     if (shell > volume && shell > 0.0) {
         // Walls thinner than two shells: everything is perimeter or solid layer.

@@ -1,16 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "zomefab/report/slicer.h"
 
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -18,24 +13,17 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <thread>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
+#include "zomefab/core/process.h"
 #include "zomefab/io/mesh_io.h"
-
-extern char** environ;
 
 namespace zomefab::report {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string formatNumber(double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.10g", v);
-    return buf;
-}
 
 /// Removes the scratch directory however the slicing ends.
 struct ScratchDir {
@@ -91,7 +79,7 @@ bool isSlicerAvailable(const std::string& executable) {
 }
 
 std::vector<std::string> prusaSlicerArguments(const PrintSettings& s, double bedMm) {
-    const std::string bed = formatNumber(bedMm);
+    const std::string bed = formatNumber(bedMm, 10);
     // PrusaSlicer refuses the "triangles" pattern at 100 % ("not supposed to work at 100%
     // density"); its solid infill is rectilinear.
     const bool isSolid = s.infillPercent >= 100.0;
@@ -99,17 +87,17 @@ std::vector<std::string> prusaSlicerArguments(const PrintSettings& s, double bed
                                      "1",
                                      "--export-gcode",
                                      "--layer-height",
-                                     formatNumber(s.layerHeightMm),
+                                     formatNumber(s.layerHeightMm, 10),
                                      "--first-layer-height",
-                                     formatNumber(s.firstLayerHeightMm),
+                                     formatNumber(s.firstLayerHeightMm, 10),
                                      "--nozzle-diameter",
-                                     formatNumber(s.nozzleMm),
+                                     formatNumber(s.nozzleMm, 10),
                                      "--filament-diameter",
                                      "2.85",
                                      "--filament-density",
                                      "1.24",
                                      "--fill-density",
-                                     formatNumber(std::min(100.0, s.infillPercent)) + "%",
+                                     formatNumber(std::min(100.0, s.infillPercent), 10) + "%",
                                      "--fill-pattern",
                                      isSolid ? "rectilinear" : "triangles",
                                      "--perimeters",
@@ -129,7 +117,7 @@ std::vector<std::string> prusaSlicerArguments(const PrintSettings& s, double bed
     // PrusaSlicer's automatic width is 1.125 × nozzle; anything else is passed explicitly.
     if (std::abs(s.extrusionWidthMm - 1.125 * s.nozzleMm) > 1e-9) {
         args.push_back("--extrusion-width");
-        args.push_back(formatNumber(s.extrusionWidthMm));
+        args.push_back(formatNumber(s.extrusionWidthMm, 10));
     }
     return args;
 }
@@ -194,37 +182,11 @@ PrintEstimate sliceWithPrusaSlicer(const TriMesh& part, const PrintSettings& set
     std::vector<std::string> args = {options.executable};
     for (std::string& a : prusaSlicerArguments(settings, bedMm)) args.push_back(std::move(a));
     args.insert(args.end(), {"-o", gcode.string(), stl.string()});
-    std::vector<char*> argv;
-    for (std::string& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-
-    // posix_spawn, not fork: safe in a process with TBB worker threads.
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&actions, 1, 2);
-    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    pid_t pid = 0;
-    const int spawned = ::posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    if (spawned != 0)
-        throw Error(ErrorCode::ProcessingFailed,
-                    "cannot start '" + options.executable + "': " + std::strerror(spawned));
-    int status = 0;
-    for (;;) {
-        const pid_t r = ::waitpid(pid, &status, WNOHANG);
-        if (r == pid) break;
-        if (r < 0 && errno != EINTR)
-            throw Error(ErrorCode::ProcessingFailed,
-                        "lost the slicer process: " + std::string(std::strerror(errno)));
-        if (context.isCancelled()) {
-            ::kill(pid, SIGTERM);
-            ::waitpid(pid, &status, 0);
-            context.throwIfCancelled();
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    ProcessOptions process;
+    process.outputPath = log.string();
+    process.context = &context;
+    const int exitCode = runProcess(args, process);
+    if (exitCode != 0)
         throw Error(ErrorCode::ProcessingFailed,
                     options.executable + " failed on " + label + ": " + lastLine(log));
 

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 #include "zomefab/sdf/level_set_grid.h"
 
 namespace zomefab::sdf {
@@ -14,75 +15,6 @@ namespace {
 
 double squaredDistance(const openvdb::Vec3s& a, const openvdb::Vec3s& b) { return (a - b).lengthSqr(); }
 
-/// Drops the vertex-connected components of @p mesh that enclose less than @p minVolumeMm3 (by
-/// absolute signed volume) and compacts the vertices. Returns how many components were dropped.
-size_t dropTinyComponents(TriMesh& mesh, double minVolumeMm3) {
-    const size_t nv = mesh.positions.size();
-    std::vector<uint32_t> parent(nv);
-    for (uint32_t i = 0; i < nv; ++i) parent[i] = i;
-    auto find = [&](uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    };
-    for (const Triangle& t : mesh.triangles) {
-        const uint32_t a = find(t[0]);
-        parent[find(t[1])] = a;
-        parent[find(t[2])] = a;
-    }
-    // Signed volume per component (divergence theorem), relative to the component's first vertex
-    // to keep the sums well conditioned far from the origin.
-    std::vector<double> volume6(nv, 0.0);
-    for (const Triangle& t : mesh.triangles) {
-        const uint32_t root = find(t[0]);
-        const Vec3f& o = mesh.positions[root];
-        double p[3][3];
-        for (int k = 0; k < 3; ++k)
-            for (int a = 0; a < 3; ++a) p[k][a] = double(mesh.positions[t[k]][a]) - o[a];
-        volume6[root] += p[0][0] * (p[1][1] * p[2][2] - p[1][2] * p[2][1]) -
-                         p[0][1] * (p[1][0] * p[2][2] - p[1][2] * p[2][0]) +
-                         p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0]);
-    }
-    std::vector<uint8_t> isKept(nv, 0);
-    size_t dropped = 0;
-    for (uint32_t v = 0; v < nv; ++v) {
-        if (find(v) != v) continue;
-        isKept[v] = std::abs(volume6[v]) / 6.0 >= minVolumeMm3;
-    }
-    std::vector<Triangle> kept;
-    kept.reserve(mesh.triangles.size());
-    std::vector<uint8_t> isCounted(nv, 0);
-    for (const Triangle& t : mesh.triangles) {
-        const uint32_t root = find(t[0]);
-        if (isKept[root]) {
-            kept.push_back(t);
-        } else if (!isCounted[root]) {
-            isCounted[root] = 1;
-            ++dropped;
-        }
-    }
-    if (dropped == 0) return 0;
-    // Compact: renumber the referenced vertices in their original order (deterministic).
-    std::vector<uint32_t> newIndex(nv, UINT32_MAX);
-    for (const Triangle& t : kept)
-        for (uint32_t v : t) newIndex[v] = 0;
-    std::vector<Vec3f> positions;
-    for (uint32_t v = 0; v < nv; ++v) {
-        if (newIndex[v] == UINT32_MAX) continue;
-        newIndex[v] = uint32_t(positions.size());
-        positions.push_back(mesh.positions[v]);
-    }
-    for (Triangle& t : kept)
-        for (uint32_t& v : t) v = newIndex[v];
-    mesh.positions = std::move(positions);
-    mesh.triangles = std::move(kept);
-    return dropped;
-}
-
-std::string formatNumber(double value) {
-    std::ostringstream s;
-    s << value;
-    return s.str();
-}
 
 }  // namespace
 
@@ -138,7 +70,10 @@ TriMesh levelSetToMesh(const LevelSet& levelSet, const LevelSetToMeshOptions& op
         }
     }
     if (options.minComponentVolumeMm3 > 0) {
-        const size_t dropped = dropTinyComponents(mesh, options.minComponentVolumeMm3);
+        const VertexComponents components = vertexComponents(mesh);
+        const size_t dropped = keepComponents(mesh, components, [&](uint32_t root) {
+            return std::abs(components.volume[root]) >= options.minComponentVolumeMm3;
+        });
         if (dropped > 0)
             context.debug("dropped " + std::to_string(dropped) + " surface fragments enclosing less than " +
                           formatNumber(options.minComponentVolumeMm3) + " mm³");

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 #include "zomefab/sdf/level_set_grid.h"
 
 namespace zomefab::sdf {
@@ -32,16 +33,10 @@ private:
     double mInvVoxel;
 };
 
-std::string formatMm(double value) {
-    std::ostringstream s;
-    s << value;
-    return s.str();
-}
-
 void requirePositive(double value, const char* what) {
     if (!(std::isfinite(value) && value > 0))
         throw Error(ErrorCode::Usage,
-                    std::string(what) + " must be a positive number of mm, got " + formatMm(value));
+                    std::string(what) + " must be a positive number of mm, got " + formatNumber(value));
 }
 
 /// The input checks meshToVolume itself does not do (it would read out of bounds or loop on NaN).
@@ -53,7 +48,6 @@ double checkMesh(const TriMesh& mesh, Box3d& bounds, double& areaMm2) {
             throw Error(ErrorCode::InvalidInput, "the mesh has a non-finite vertex coordinate");
     }
     const size_t n = mesh.positions.size();
-    double volume6 = 0;
     double area2 = 0;
     for (const Triangle& t : mesh.triangles) {
         if (t[0] >= n || t[1] >= n || t[2] >= n)
@@ -65,12 +59,11 @@ double checkMesh(const TriMesh& mesh, Box3d& bounds, double& areaMm2) {
         const double ac[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
         const double cr[3] = {ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2],
                               ab[0] * ac[1] - ab[1] * ac[0]};
-        volume6 += a[0] * cr[0] + a[1] * cr[1] + a[2] * cr[2];
         area2 += std::sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
     }
     bounds = boundingBox(mesh);
     areaMm2 = area2 / 2;
-    return volume6 / 6;
+    return signedVolume(mesh);
 }
 
 /// What a finished conversion looks like from outside: how much is inside, and whether the inside
@@ -129,9 +122,9 @@ LevelSet meshToLevelSet(const TriMesh& mesh, const MeshToLevelSetOptions& option
                                    (isWholeInterior ? meshVolume / (voxel * voxel * voxel) : 0.0);
     constexpr double kMaxVoxels = 1.0e9;  // ~4 GB of float values plus the tree
     if (maxExtent / voxel > double(1 << 30) || estimatedVoxels > kMaxVoxels) {
-        throw Error(ErrorCode::Usage, "a " + formatMm(voxel) + " mm voxel is too small for a " +
-                                          formatMm(maxExtent) + " mm mesh (about " +
-                                          formatMm(std::round(estimatedVoxels / 1e6)) +
+        throw Error(ErrorCode::Usage, "a " + formatNumber(voxel) + " mm voxel is too small for a " +
+                                          formatNumber(maxExtent) + " mm mesh (about " +
+                                          formatNumber(std::round(estimatedVoxels / 1e6)) +
                                           " million voxels); use a larger voxel size");
     }
 
@@ -154,7 +147,7 @@ LevelSet meshToLevelSet(const TriMesh& mesh, const MeshToLevelSetOptions& option
         throw Error(
             ErrorCode::ProcessingFailed,
             "the level set has no inside: the mesh is open, inside out with holes, or thinner than a " +
-                formatMm(voxel) + " mm voxel everywhere");
+                formatNumber(voxel) + " mm voxel everywhere");
     }
     if (stats.touchesBorder) {
         throw Error(ErrorCode::ProcessingFailed,
@@ -165,8 +158,8 @@ LevelSet meshToLevelSet(const TriMesh& mesh, const MeshToLevelSetOptions& option
     // a leaking fill loses most of it. Half is far outside any discretisation error.
     if (insideVolume < 0.5 * meshVolume) {
         throw Error(ErrorCode::ProcessingFailed,
-                    "the level set's inside (" + formatMm(std::round(insideVolume)) +
-                        " mm³) is far smaller than the mesh's volume (" + formatMm(std::round(meshVolume)) +
+                    "the level set's inside (" + formatNumber(std::round(insideVolume)) +
+                        " mm³) is far smaller than the mesh's volume (" + formatNumber(std::round(meshVolume)) +
                         " mm³): the mesh is not closed or it self-intersects, so the inside leaked out");
     }
 

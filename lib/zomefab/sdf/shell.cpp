@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 #include "zomefab/sdf/level_set_grid.h"
 
 namespace zomefab::sdf {
@@ -44,35 +45,29 @@ openvdb::FloatGrid::Ptr shiftedNarrowBand(const openvdb::FloatGrid& source, floa
     return grid;
 }
 
-std::string formatMm(double value) {
-    std::ostringstream s;
-    s << value;
-    return s.str();
-}
-
 }  // namespace
 
 void checkShellOptions(const ShellOptions& options) {
     if (!(std::isfinite(options.shellMm) && options.shellMm >= 1.0))
         throw Error(ErrorCode::Usage,
-                    "the shell thickness must be at least 1 mm, got " + formatMm(options.shellMm));
+                    "the shell thickness must be at least 1 mm, got " + formatNumber(options.shellMm));
 }
 
 LevelSet makeShell(const LevelSet& object, const ShellOptions& options, RunContext& context) {
     checkShellOptions(options);
     const LevelSetInfo& source = object.info();
     if (options.shellMm > source.interiorBandMm * (1 + 1e-9)) {
-        throw Error(ErrorCode::Usage, "a " + formatMm(options.shellMm) +
+        throw Error(ErrorCode::Usage, "a " + formatNumber(options.shellMm) +
                                           " mm shell needs exact distances that deep, but the '" +
                                           source.name + "' grid's interior band reaches " +
-                                          formatMm(source.interiorBandMm) +
+                                          formatNumber(source.interiorBandMm) +
                                           " mm; rebuild it with a deeper band (zf-sdf --shell-depth-mm " +
-                                          formatMm(options.shellMm) + ")");
+                                          formatNumber(options.shellMm) + ")");
     }
     const openvdb::FloatGrid::ConstPtr grid = levelSetGrid(object);
     const double voxel = grid->voxelSize()[0];
     if (options.shellMm < 2 * voxel) {
-        context.warn("the " + formatMm(options.shellMm) + " mm shell is thinner than two " + formatMm(voxel) +
+        context.warn("the " + formatNumber(options.shellMm) + " mm shell is thinner than two " + formatNumber(voxel) +
                      " mm voxels; its walls may mesh with holes (use a smaller voxel)");
     }
     const float halfWidthMm = float(kHalfWidthVoxels * voxel);

@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/vec.h"
 
 namespace zomefab::zome {
 
@@ -16,9 +17,10 @@ namespace {
 constexpr double kMaxGridCells = 2.0e6;
 
 inline double sq(double x) { return x * x; }
-inline Vec3d sub(const Vec3d& a, const Vec3d& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-inline double dot3(const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-inline double distanceSq(const Vec3d& a, const Vec3d& b) { return dot3(sub(a, b), sub(a, b)); }
+// zome:: has exact (golden) dot and cross; these are the millimetre ones.
+using zomefab::dist2;
+using zomefab::dot;
+using zomefab::sub;
 
 std::string ballName(BallId id) { return "ball " + std::to_string(id); }
 
@@ -41,11 +43,11 @@ namespace {
 inline double pointSegmentDistanceSqInline(const Vec3d& p, const Vec3d& a, const Vec3d& b) {
     const Vec3d ab = sub(b, a);
     const Vec3d ap = sub(p, a);
-    const double len2 = dot3(ab, ab);
-    double t = len2 > 0.0 ? dot3(ap, ab) / len2 : 0.0;
+    const double len2 = dot(ab, ab);
+    double t = len2 > 0.0 ? dot(ap, ab) / len2 : 0.0;
     t = std::clamp(t, 0.0, 1.0);
     const Vec3d c{a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]};
-    return distanceSq(p, c);
+    return dist2(p, c);
 }
 
 inline double segmentSegmentDistanceSqInline(const Vec3d& p0, const Vec3d& p1, const Vec3d& q0,
@@ -54,20 +56,20 @@ inline double segmentSegmentDistanceSqInline(const Vec3d& p0, const Vec3d& p1, c
     const Vec3d d1 = sub(p1, p0);
     const Vec3d d2 = sub(q1, q0);
     const Vec3d r = sub(p0, q0);
-    const double a = dot3(d1, d1);
-    const double e = dot3(d2, d2);
-    const double f = dot3(d2, r);
+    const double a = dot(d1, d1);
+    const double e = dot(d2, d2);
+    const double f = dot(d2, r);
     constexpr double kEps = 1e-18;
     double s = 0.0, t = 0.0;
-    if (a <= kEps && e <= kEps) return dot3(r, r);
+    if (a <= kEps && e <= kEps) return dot(r, r);
     if (a <= kEps) {
         t = std::clamp(f / e, 0.0, 1.0);
     } else {
-        const double c = dot3(d1, r);
+        const double c = dot(d1, r);
         if (e <= kEps) {
             s = std::clamp(-c / a, 0.0, 1.0);
         } else {
-            const double b = dot3(d1, d2);
+            const double b = dot(d1, d2);
             const double denom = a * e - b * b;  // ≥ 0; 0 when parallel
             s = denom > kEps * a * e ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
             t = (b * s + f) / e;
@@ -82,7 +84,7 @@ inline double segmentSegmentDistanceSqInline(const Vec3d& p0, const Vec3d& p1, c
     }
     const Vec3d c1{p0[0] + d1[0] * s, p0[1] + d1[1] * s, p0[2] + d1[2] * s};
     const Vec3d c2{q0[0] + d2[0] * t, q0[1] + d2[1] * t, q0[2] + d2[2] * t};
-    return distanceSq(c1, c2);
+    return dist2(c1, c2);
 }
 
 /// Cheap rejection: the entry's bounding box is farther than @p limit from [lo, hi] on some axis.
@@ -406,7 +408,7 @@ bool Structure::ballCollides(const GoldenVector3& position) const {
             const double limit = mStrutBallMm[e.color];
             return !boxesApart(e, p, p, limit) && pointSegmentDistanceSqInline(p, e.p0, e.p1) < sq(limit);
         }
-        return distanceSq(p, e.p0) < ballBall2;
+        return dist2(p, e.p0) < ballBall2;
     });
 }
 
@@ -474,7 +476,7 @@ std::vector<Collision> findCollisions(const Structure& s) {
                 if (d2 < sq(limit))
                     out.push_back({CollisionKind::StrutBall, e.key & ~kBit, i, std::sqrt(d2), limit});
             } else if (e.key > i) {
-                const double d2 = distanceSq(p, e.p0);
+                const double d2 = dist2(p, e.p0);
                 if (d2 < sq(s.mBallBallMm))
                     out.push_back({CollisionKind::BallBall, i, e.key, std::sqrt(d2), s.mBallBallMm});
             }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "zomefab/core/json_values.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/version.h"
 
@@ -27,13 +28,6 @@ int64_t requireInt(const json& j, const std::string& what) {
     }
     if (j.is_number_integer()) return j.get<int64_t>();
     fail(what + " must be an integer");
-}
-
-double requireNumber(const json& j, const std::string& what) {
-    if (!j.is_number()) fail(what + " must be a number");
-    const double x = j.get<double>();
-    if (!std::isfinite(x)) fail(what + " must be finite");
-    return x;
 }
 
 const json* member(const json& object, const char* key) {
@@ -63,23 +57,6 @@ GoldenVector3 readExact(const json& j, const std::string& who) {
     return v;
 }
 
-Vec3d readVec3(const json& j, const std::string& what) {
-    if (!j.is_array() || j.size() != 3) fail(what + " must be an array of 3 numbers");
-    return {requireNumber(j[0], what), requireNumber(j[1], what), requireNumber(j[2], what)};
-}
-
-Transform4d readTransform(const json& j) {
-    const char* what = "transform_mm";
-    if (!j.is_array() || j.size() != 4) fail(std::string(what) + " must be a 4x4 array of rows");
-    Transform4d t;
-    for (size_t r = 0; r < 4; ++r) {
-        if (!j[r].is_array() || j[r].size() != 4) fail(std::string(what) + " must be a 4x4 array of rows");
-        for (size_t c = 0; c < 4; ++c) t.m[r * 4 + c] = requireNumber(j[r][c], what);
-    }
-    if (t.m[12] != 0.0 || t.m[13] != 0.0 || t.m[14] != 0.0 || t.m[15] != 1.0)
-        fail(std::string(what) + " must be affine (last row 0 0 0 1)");
-    return t;
-}
 
 }  // namespace
 
@@ -90,10 +67,7 @@ json structureToJson(const Structure& s, const Transform4d& transformMm) {
     out["generator"] = generatorString();
     out["b0_mm"] = s.scale().b0Mm;
     out["unit_mm"] = s.scale().unitMm();
-    json t = json::array();
-    for (int r = 0; r < 4; ++r)
-        t.push_back({transformMm.at(r, 0), transformMm.at(r, 1), transformMm.at(r, 2), transformMm.at(r, 3)});
-    out["transform_mm"] = std::move(t);
+    out["transform_mm"] = toJson(transformMm);
     json balls = json::array();
     for (BallId id : s.ballIds()) {
         const Ball& b = s.ball(id);
@@ -138,11 +112,11 @@ Structure structureFromJson(const json& j, const ZomeScale& physical, const Coll
     const json* b0 = member(j, "b0_mm");
     const json* unit = member(j, "unit_mm");
     if (b0) {
-        scale.b0Mm = requireNumber(*b0, "b0_mm");
+        scale.b0Mm = numberFromJson(*b0, "b0_mm");
         if (scale.b0Mm <= 0.0) fail("b0_mm must be positive");
     }
     if (unit) {
-        const double u = requireNumber(*unit, "unit_mm");
+        const double u = numberFromJson(*unit, "unit_mm");
         if (u <= 0.0) fail("unit_mm must be positive");
         if (!b0) {
             scale.b0Mm = u * 2.0 * kPhi * kPhi;
@@ -156,7 +130,7 @@ Structure structureFromJson(const json& j, const ZomeScale& physical, const Coll
     }
     if (transformMm) *transformMm = Transform4d::identity();
     if (const json* t = member(j, "transform_mm")) {
-        const Transform4d transform = readTransform(*t);
+        const Transform4d transform = transformFromJson(*t, "transform_mm");
         if (transformMm) *transformMm = transform;
     }
 
@@ -191,7 +165,7 @@ Structure structureFromJson(const json& j, const ZomeScale& physical, const Coll
     }
     for (const Entry& e : entries) {
         if (!e.mm) continue;
-        const Vec3d mm = readVec3(*e.mm, ballLabel(e.id) + ": mm");
+        const Vec3d mm = vec3FromJson(*e.mm, ballLabel(e.id) + ": mm");
         const Vec3d p = e.exact.toDouble();
         const double u = scale.unitMm();
         scale.originMm = {mm[0] - p[0] * u, mm[1] - p[1] * u, mm[2] - p[2] * u};
@@ -207,7 +181,7 @@ Structure structureFromJson(const json& j, const ZomeScale& physical, const Coll
             fail(err.message());  // already names the ball
         }
         if (e.mm) {
-            const Vec3d mm = readVec3(*e.mm, ballLabel(e.id) + ": mm");
+            const Vec3d mm = vec3FromJson(*e.mm, ballLabel(e.id) + ": mm");
             const Vec3d& expected = s.ball(id).positionMm;
             for (int k = 0; k < 3; ++k) {
                 if (std::abs(mm[size_t(k)] - expected[size_t(k)]) > kMmCheckToleranceMm) {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/vec.h"
 
 namespace zomefab::zome {
 
@@ -89,8 +90,6 @@ struct Built {
     Catalogue catalogue;
 };
 
-double length(const Vec3d& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
-
 Built build() {
     Built built;
     ZomeTables& t = built.tables;
@@ -114,10 +113,10 @@ Built build() {
                     v = Golden::phi() * v;  // size n+1 = φ × size n
                 }
                 const Vec3d d = h.vectorUnits[0];
-                const double len = length(d);
+                const double len = norm(d);
                 h.direction = {d[0] / len, d[1] / len, d[2] / len};
                 for (int size = 0; size < kSizeCount; ++size)
-                    t.lengthUnits[size_t(color)][size_t(size)] = length(h.vectorUnits[size_t(size)]);
+                    t.lengthUnits[size_t(color)][size_t(size)] = norm(h.vectorUnits[size_t(size)]);
             }
         }
     }
@@ -141,7 +140,7 @@ Built build() {
                 u = {e[0] - c * h.direction[0], e[1] - c * h.direction[1], e[2] - c * h.direction[2]};
             }
         }
-        const double len = length(u);
+        const double len = norm(u);
         h.sectionAxis = {u[0] / len, u[1] / len, u[2] / len};
     }
     for (int hole = 0; hole < kHoleCount; ++hole)

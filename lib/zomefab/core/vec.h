@@ -1,25 +1,32 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-/// @file Small Vec3d helpers shared by the pieces stage (no dependencies beyond core).
+/// @file Vec3d arithmetic shared by every module (the one copy: dot, cross, norms, the linear
+/// part of a transform). Plain functions over std::array so the value types stay aggregates.
 #pragma once
 
-#include <algorithm>
 #include <cmath>
 
 #include "zomefab/core/transform.h"
 #include "zomefab/core/tri_mesh.h"
 
-namespace zomefab::pieces::detail {
+namespace zomefab {
 
 inline Vec3d add(const Vec3d& a, const Vec3d& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
 inline Vec3d sub(const Vec3d& a, const Vec3d& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 inline Vec3d scale(const Vec3d& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
 /// a + s·b
-inline Vec3d madd(const Vec3d& a, double s, const Vec3d& b) { return {a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]}; }
+inline Vec3d madd(const Vec3d& a, double s, const Vec3d& b) {
+    return {a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]};
+}
 inline double dot(const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 inline Vec3d cross(const Vec3d& a, const Vec3d& b) {
     return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 inline double norm(const Vec3d& a) { return std::sqrt(dot(a, a)); }
+/// |a − b|²
+inline double dist2(const Vec3d& a, const Vec3d& b) {
+    const double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
+    return x * x + y * y + z * z;
+}
 /// a / |a|, or a itself when it is zero.
 inline Vec3d normalized(const Vec3d& a) {
     const double n = norm(a);
@@ -34,12 +41,4 @@ inline Vec3d applyLinear(const Transform4d& t, const Vec3d& v) {
             t.at(2, 0) * v[0] + t.at(2, 1) * v[1] + t.at(2, 2) * v[2]};
 }
 
-/// Signed distance to the box centred at the origin with half sizes @p half (Quílez's formula):
-/// exact outside, the distance to the nearest face inside.
-inline double boxDistance(const Vec3d& p, const Vec3d& half) {
-    const double qx = std::abs(p[0]) - half[0], qy = std::abs(p[1]) - half[1], qz = std::abs(p[2]) - half[2];
-    const double ox = std::max(qx, 0.0), oy = std::max(qy, 0.0), oz = std::max(qz, 0.0);
-    return std::sqrt(ox * ox + oy * oy + oz * oz) + std::min(std::max(qx, std::max(qy, qz)), 0.0);
-}
-
-}  // namespace zomefab::pieces::detail
+}  // namespace zomefab
