@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
         // The default run against one with other graph sizes or another first w_smoothness.
         double cpu = cpuSeconds();
         const Stopwatch w;
-        const PartitionResult r = partitionSurface(mesh, frame.structure, frame.outermost, o, RunContext::silent());
+        const PartitionResult r = partitionSurface(mesh, frame.structure, frame.outermost, Fabrication{}, o, RunContext::silent());
         report(what, mesh, frame.outermost, r, w.seconds(), cpuSeconds() - cpu);
         PartitionOptions fine = o;
         fine.graphNodeTarget = compareGraphNodes;
@@ -158,7 +158,7 @@ int main(int argc, char** argv) {
         if (compareSmoothness > 0) fine.smoothnessStart = compareSmoothness;
         cpu = cpuSeconds();
         const Stopwatch w2;
-        const PartitionResult rf = partitionSurface(mesh, frame.structure, frame.outermost, fine, RunContext::silent());
+        const PartitionResult rf = partitionSurface(mesh, frame.structure, frame.outermost, Fabrication{}, fine, RunContext::silent());
         std::printf("comparison run: graph nodes %zu, refinement nodes %zu (0 = faces / one level), w_smoothness %g\n",
                     fine.graphNodeTarget, fine.refineNodeTarget, fine.smoothnessStart);
         report("same, comparison run",
@@ -180,7 +180,7 @@ int main(int argc, char** argv) {
     if (mode == "bunny" || mode == "all") {
         const double cpu = cpuSeconds();
         const Stopwatch w;
-        const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, o, RunContext::silent());
+        const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, Fabrication{}, o, RunContext::silent());
         report("bunny_cgal_75k at 400 mm, printer 200 mm^3", bunny.mesh, frame.outermost, r, w.seconds(), cpuSeconds() - cpu);
     }
     if (mode == "compare") compare("bunny_cgal_75k at 400 mm, printer 200 mm^3", bunny.mesh);
@@ -191,7 +191,7 @@ int main(int argc, char** argv) {
         } else {
             const double cpu = cpuSeconds();
             const Stopwatch w;
-            const PartitionResult r = partitionSurface(fine, frame.structure, frame.outermost, o, RunContext::silent());
+            const PartitionResult r = partitionSurface(fine, frame.structure, frame.outermost, Fabrication{}, o, RunContext::silent());
             report("bunny_cgal_75k subdivided twice (1-to-4 midpoint), 400 mm", fine, frame.outermost, r, w.seconds(),
                    cpuSeconds() - cpu);
         }

@@ -16,6 +16,7 @@
 #include "zomefab/core/error.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/io/file_io.h"
+#include "zomefab/partition/partition_json.h"
 #include "zomefab/pieces/pieces.h"
 #include "zomefab/pieces/pieces_io.h"
 #include "zomefab/sdf/vdb_file.h"
@@ -25,15 +26,6 @@ using namespace zomefab;
 namespace fs = std::filesystem;
 
 namespace {
-
-Vec3d vec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
-
-Transform4d matrix(const nlohmann::json& j) {
-    Transform4d t;
-    for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c) t.m[size_t(r * 4 + c)] = j[size_t(r)][size_t(c)].get<double>();
-    return t;
-}
 
 uintmax_t directoryBytes(const std::string& dir, const std::string& extension) {
     uintmax_t total = 0;
@@ -66,29 +58,17 @@ int main(int argc, char** argv) {
         const sdf::LevelSet& shell = sdf::findLevelSet(grids, "shell", shellPath);
         Transform4d frameTransform;
         const zome::Structure frame = zome::structureFromJsonText(readInputBytes(framePath), {}, {}, &frameTransform);
-        // The partition's cells and pieces (the fields zf-pieces reads; its reader checks them).
-        const nlohmann::json partition = nlohmann::json::parse(readInputBytes(partitionPath));
-        pieces::CellModel cells;
-        for (const nlohmann::json& c : partition["cells"]) {
-            cells.w.push_back(vec3(c["w"]));
-            cells.b.push_back(c["b"].get<double>());
-        }
-        std::vector<pieces::PieceRequest> requests;
-        for (const nlohmann::json& p : partition["pieces"]) {
-            pieces::PieceRequest r;
-            r.cells = p["cells"].get<std::vector<uint32_t>>();
-            r.boundsMm.expand(vec3(p["bbox_mm"]["min"]));
-            r.boundsMm.expand(vec3(p["bbox_mm"]["max"]));
-            requests.push_back(r);
-        }
+        const partition::PartitionFile partition =
+            partition::partitionFromJson(nlohmann::json::parse(readInputBytes(partitionPath)));
         pieces::PiecesOptions options;
-        if (partition.contains("printer_mm")) options.printerMm = vec3(partition["printer_mm"]);
-        if (!(matrix(partition["transform_mm"]) == frameTransform))
+        Fabrication fabrication;
+        fabrication.printerMm = partition.result.printerMm;
+        if (!isNearlyEqual(partition.info.transformMm, frameTransform))
             std::fprintf(stderr, "bench_pieces: warning: the partition's transform_mm differs from the frame's\n");
         const double readSeconds = clock.seconds();
 
         const Transform4d frameToGrid = shell.info().transformMm * affineInverse(frameTransform);
-        const pieces::Pieces result = pieces::makePieces(shell, frame, frameToGrid, cells, requests, options, context);
+        const pieces::Pieces result = pieces::makePieces(shell, frame, frameToGrid, partition.result, fabrication, options, context);
         const double piecesSeconds = clock.seconds() - readSeconds;
 
         const bool isTemporary = outDir.empty();

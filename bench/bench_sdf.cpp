@@ -39,7 +39,7 @@ struct Args {
     double heightMm = 400;
     bool isYUp = false;
     double voxelMm = sdf::ObjectFieldOptions().voxelMm;
-    double shellMm = sdf::ShellOptions().shellMm;
+    double shellMm = Fabrication().wallMm;
     double fieldVoxelMm = sdf::ObjectFieldOptions().fieldVoxelMm;
     bool isAccuracy = false;
     bool isFieldOnly = false;  ///< --accuracy without the round trip
@@ -122,12 +122,11 @@ void runSteps(const Args& args) {
 
     sdf::ObjectFieldOptions objectOptions;
     objectOptions.voxelMm = args.voxelMm;
-    objectOptions.shellDepthMm = args.shellMm;
-    objectOptions.fieldVoxelMm = args.fieldVoxelMm;
+        objectOptions.fieldVoxelMm = args.fieldVoxelMm;
     clock = StepClock();
     sdf::MeshToLevelSetOptions objectLevelSet;
     objectLevelSet.voxelMm = objectOptions.voxelMm;
-    objectLevelSet.interiorBandMm = objectOptions.shellDepthMm;
+    objectLevelSet.interiorBandMm = args.shellMm;
     const sdf::LevelSet object = sdf::meshToLevelSet(scaled.mesh, objectLevelSet, context);
     const double objectSeconds = clock.wall.seconds(), objectCpu = clock.cpu();
 
@@ -145,9 +144,9 @@ void runSteps(const Args& args) {
     const double writeSeconds = clock.wall.seconds(), writeCpu = clock.cpu();
 
     clock = StepClock();
-    sdf::ShellOptions shellOptions;
-    shellOptions.shellMm = args.shellMm;
-    const sdf::LevelSet shell = sdf::makeShell(object, shellOptions, context);
+    Fabrication fabrication;
+    fabrication.wallMm = args.shellMm;
+    const sdf::LevelSet shell = sdf::makeShell(object, fabrication, context);
     const double shellSeconds = clock.wall.seconds(), shellCpu = clock.cpu();
 
     clock = StepClock();
@@ -186,7 +185,7 @@ void runSteps(const Args& args) {
     std::printf("step                          wall s   CPU s\n");
     std::printf("read+validate+scale          %6.2f  %6.2f\n", readSeconds, readCpu);
     std::printf("object (%g mm, %g mm deep)   %6.2f  %6.2f  %10zu active voxels  %7.1f MB\n",
-                object.info().voxelMm, objectOptions.shellDepthMm, objectSeconds, objectCpu,
+                object.info().voxelMm, args.shellMm, objectSeconds, objectCpu,
                 object.activeVoxelCount(), megabytes(object.memoryBytes()));
     std::printf("interior (%g mm, whole)      %6.2f  %6.2f  %10zu active voxels  %7.1f MB\n",
                 interior.info().voxelMm, interiorSeconds, interiorCpu, interior.activeVoxelCount(),

@@ -60,6 +60,12 @@ inline ErrorCode errorCodeOf(const std::function<void()>& f) {
 
 /// An axis-aligned box [min, max] as 12 outward triangles on 8 shared vertices.
 TriMesh makeBox(const Vec3d& min, const Vec3d& max);
+/// Pointers to each of @p meshes (what costReport and PreviewInput take).
+inline std::vector<const TriMesh*> pointersTo(const std::vector<TriMesh>& meshes) {
+    std::vector<const TriMesh*> out;
+    for (const TriMesh& m : meshes) out.push_back(&m);
+    return out;
+}
 /// A closed, outward UV sphere (rings × segments quads split into triangles, poles fanned).
 TriMesh makeSphere(const Vec3d& center, double radius, int rings = 32, int segments = 64);
 

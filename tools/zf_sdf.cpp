@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file zf-sdf: mesh -> OBJECT.vdb with the object's distance fields (docs/sdf.md): "object"
-/// (fine, exact to --shell-depth-mm inside, for zf-shell) and "interior" (coarse, the whole
+/// (fine, exact as deep as --shell-mm, for zf-shell) and "interior" (coarse, the whole
 /// inside, for the frame optimisation), in millimetres, z up, with the input->mm transform.
 #include <cstdio>
 
 #include "common/cli.h"
-#include "common/scale_options.h"
+#include "common/stage_options.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/version.h"
 #include "zomefab/io/file_io.h"
@@ -23,24 +23,21 @@ int main(int argc, char** argv) {
                    "Turn a closed mesh into signed distance level sets (OpenVDB .vdb, millimetres).");
     std::string input, output, inFormat;
     cli::ScaleCli scaleCli;
-    sdf::ObjectFieldOptions options;
+    cli::FabricationCli fabricationCli;
+    cli::FieldCli fieldCli;
     auto& app = tool.app();
     app.add_option("mesh", input, "Closed mesh (.stl .obj .ply .gltf .glb); - reads stdin")->required();
     app.add_option("-o,--output", output, "Output .vdb; - writes stdout")->required();
     scaleCli.addTo(app);
     tool.addFormatOption("--in-format", inFormat, {"stl", "obj", "ply", "gltf", "glb"},
                          "Input format (needed for -)");
-    app.add_option("--voxel-mm", options.voxelMm, "Voxel size of the object grid")->capture_default_str();
-    app.add_option("--shell-depth-mm", options.shellDepthMm,
-                   "Exact distances this deep inside: the thickest shell zf-shell can cut")
-        ->capture_default_str();
-    app.add_option("--field-voxel-mm", options.fieldVoxelMm,
-                   "Voxel size of the interior grid (frame optimisation)")
-        ->capture_default_str();
+    fabricationCli.addTo(app, cli::kWall);
+    fieldCli.addTo(app);
 
     return tool.run(argc, argv, [&](json& report) {
         const mesh::ScaleOptions scaleOptions = scaleCli.resolve();  // bad options fail before any input is read
-        sdf::checkObjectFieldOptions(options);
+        const Fabrication fabrication = fabricationCli.resolve(tool.common().seed);
+        sdf::checkObjectFieldOptions(fieldCli.options);
         MeshReadOptions readOptions;
         if (!inFormat.empty()) readOptions.format = meshFormatFromName(inFormat);
         RunContext& context = tool.context();
@@ -50,7 +47,7 @@ int main(int argc, char** argv) {
         const double readSeconds = clock.seconds();
         sdf::ObjectField field;
         try {
-            field = sdf::makeObjectField(scaled.mesh, options, context);
+            field = sdf::makeObjectField(scaled.mesh, fabrication, fieldCli.options, context);
         } catch (const Error& e) {
             // Input problems found only now (no inside, a leaking inside) are about this file.
             if (e.code() == ErrorCode::Usage || e.code() == ErrorCode::Cancelled) throw;

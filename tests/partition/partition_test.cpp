@@ -97,7 +97,8 @@ TEST_CASE("partition: a salient belt across the natural seam is never cut") {
     TriMesh sphere = zomefab::test::makeSphere({0, 0, 0}, 100.0, 48, 96);
     const zome::Structure frame = ballsAt({{-1, 0, 0}, {1, 0, 0}});
     PartitionOptions o;
-    o.printerMm = {210, 210, 150};
+    Fabrication fab;
+    fab.printerMm = {210, 210, 150};
     std::vector<uint8_t> belt(sphere.triangles.size(), 0);
     for (size_t f = 0; f < belt.size(); ++f) {
         double x = 0;
@@ -106,14 +107,14 @@ TEST_CASE("partition: a salient belt across the natural seam is never cut") {
     }
 
     // Without saliency the seam runs through the belt: the case tempts the cut.
-    const PartitionResult plain = partitionSurface(sphere, frame, {0, 1}, o, RunContext::silent());
+    const PartitionResult plain = partitionSurface(sphere, frame, {0, 1}, fab, o, RunContext::silent());
     checkResult(sphere, plain);
     CHECK(plain.pieces.size() == 2);
     CHECK_FALSE(isKeptWhole(sphere, plain, belt));
 
     // Marked in the mesh (as a PLY `salient` property would), the belt stays in one piece.
     sphere.salientFaces = belt;
-    const PartitionResult kept = partitionSurface(sphere, frame, {0, 1}, o, RunContext::silent());
+    const PartitionResult kept = partitionSurface(sphere, frame, {0, 1}, fab, o, RunContext::silent());
     checkResult(sphere, kept);
     CHECK(kept.salientRegions == 1);
     CHECK(kept.salientRegionsSplit == 0);
@@ -126,7 +127,7 @@ TEST_CASE("partition: a salient belt across the natural seam is never cut") {
         PartitionOptions noRetry = o;
         noRetry.salientRetries = 0;
         RunContext log;
-        const PartitionResult r = partitionSurface(sphere, frame, {0, 1}, noRetry, log);
+        const PartitionResult r = partitionSurface(sphere, frame, {0, 1}, fab, noRetry, log);
         const bool isWarned = !log.warnings().empty();
         CHECK((isKeptWhole(sphere, r, belt) ? r.salientRegionsSplit == 0 && !isWarned
                                             : r.salientRegionsSplit == 1 && isWarned));
@@ -138,7 +139,7 @@ TEST_CASE("partition: a salient belt across the natural seam is never cut") {
         PartitionOptions byIndex = o;
         for (uint32_t f = 0; f < belt.size(); ++f)
             if (belt[f]) byIndex.salientFaceIndices.push_back(f);
-        const PartitionResult r = partitionSurface(sphere, frame, {0, 1}, byIndex, RunContext::silent());
+        const PartitionResult r = partitionSurface(sphere, frame, {0, 1}, fab, byIndex, RunContext::silent());
         CHECK(r.salientFaces == belt);
         CHECK(isKeptWhole(sphere, r, belt));
     }
@@ -146,7 +147,7 @@ TEST_CASE("partition: a salient belt across the natural seam is never cut") {
     // A sphere of saliency where the seam would cross the top.
     PartitionOptions bySphere = o;
     bySphere.salientSpheres.push_back({{0, 0, 100}, 30.0});
-    const PartitionResult capped = partitionSurface(sphere, frame, {0, 1}, bySphere, RunContext::silent());
+    const PartitionResult capped = partitionSurface(sphere, frame, {0, 1}, fab, bySphere, RunContext::silent());
     checkResult(sphere, capped);
     const std::vector<uint8_t> cap = salientFaceFlags(sphere, bySphere.salientSpheres, {});
     CHECK(std::count(cap.begin(), cap.end(), uint8_t(1)) > 20);
@@ -160,8 +161,9 @@ TEST_CASE("partition: small bunny, energies, pieces, determinism across thread c
     const partition::test::LatticeFrame frame = partition::test::makeLatticeFrame(bunny.mesh, 12.0);
     REQUIRE(frame.outermost.size() >= 8);
     PartitionOptions o;
-    o.printerMm = {120, 120, 120};  // forces several pieces on a 300 mm bunny
-    const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, o, RunContext::silent());
+    Fabrication fab;
+    fab.printerMm = {120, 120, 120};  // forces several pieces on a 300 mm bunny
+    const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent());
     checkResult(bunny.mesh, r);
     CHECK(r.graphCutPartitions < r.nearestPartitions);
     CHECK(r.energyGraphCut < r.energyNearest);
@@ -208,11 +210,11 @@ TEST_CASE("partition: small bunny, energies, pieces, determinism across thread c
     std::string one, two;
     {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-        one = partitionToJson(partitionSurface(bunny.mesh, frame.structure, frame.outermost, o, RunContext::silent()), o, info).dump();
+        one = partitionToJson(partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent()), o, info).dump();
     }
     {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-        two = partitionToJson(partitionSurface(bunny.mesh, frame.structure, frame.outermost, o, RunContext::silent()), o, info).dump();
+        two = partitionToJson(partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent()), o, info).dump();
     }
     CHECK(one == two);
     CHECK(one == partitionToJson(r, o, info).dump());
@@ -221,7 +223,7 @@ TEST_CASE("partition: small bunny, energies, pieces, determinism across thread c
 TEST_CASE("partition: bunny at 400 mm, every piece fits 200 mm cubed") {
     const partition::test::MeshMm bunny = partition::test::loadMeshMm(zomefab::test::dataPath("bunny_cgal_75k.stl"), 400.0, true);
     const partition::test::LatticeFrame frame = partition::test::makeLatticeFrame(bunny.mesh, 12.0);
-    const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, {}, RunContext::silent());
+    const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, Fabrication{}, {}, RunContext::silent());
     checkResult(bunny.mesh, r);
     CHECK(r.printerMm == Vec3d{200, 200, 200});
     CHECK(r.pieces.size() >= 3);  // a 400 mm bunny does not fit a 200 mm printer in fewer
@@ -234,9 +236,10 @@ TEST_CASE("partition: when the schedule bottoms out, oversized partitions are sp
     const TriMesh sphere = zomefab::test::makeSphere({0, 0, 0}, 60.0, 32, 64);
     const zome::Structure frame = ballsAt({{0, 0, 0}});
     PartitionOptions o;
-    o.printerMm = {70, 70, 70};
+    Fabrication fab;
+    fab.printerMm = {70, 70, 70};
     RunContext quiet;
-    const PartitionResult r = partitionSurface(sphere, frame, {0}, o, quiet);
+    const PartitionResult r = partitionSurface(sphere, frame, {0}, fab, o, quiet);
     checkResult(sphere, r);
     CHECK(r.isScheduleBottomedOut);
     CHECK(r.splits >= 1);
@@ -252,9 +255,9 @@ TEST_CASE("partition: bad inputs fail with clear messages") {
     const TriMesh sphere = zomefab::test::makeSphere({0, 0, 0}, 100.0, 16, 32);
     const zome::Structure frame = ballsAt({{-1, 0, 0}, {1, 0, 0}});
     auto fails = [&](const zome::Structure& s, const std::vector<zome::BallId>& labels, const PartitionOptions& o,
-                     ErrorCode code, const std::string& text) {
+                     ErrorCode code, const std::string& text, const Fabrication& fab = {}) {
         try {
-            partitionSurface(sphere, s, labels, o, RunContext::silent());
+            partitionSurface(sphere, s, labels, fab, o, RunContext::silent());
             FAIL("no error for: " << text);
         } catch (const Error& e) {
             CHECK(e.code() == code);
@@ -264,10 +267,10 @@ TEST_CASE("partition: bad inputs fail with clear messages") {
     fails(frame, {}, {}, ErrorCode::InvalidInput, "no outermost balls");
     fails(zome::Structure{}, {}, {}, ErrorCode::InvalidInput, "no balls at all");
     fails(frame, {0, 7}, {}, ErrorCode::InvalidInput, "label ball 7 is not a ball of the frame");
-    PartitionOptions tiny;
+    Fabrication tiny;
     tiny.printerMm = {10, 200, 200};
-    fails(frame, {0, 1}, tiny, ErrorCode::Usage, "smaller than a Zome ball");
-    CHECK_THROWS_AS(checkPartitionOptions(tiny), Error);
+    fails(frame, {0, 1}, {}, ErrorCode::Usage, "smaller than a Zome ball", tiny);
+    CHECK_THROWS_AS(checkPartitionOptions({}, tiny), Error);
     // A frame for another mesh: a ball 20 B0 away.
     const zome::Structure far = ballsAt({{-1, 0, 0}, {20, 0, 0}});
     fails(far, {0, 1}, {}, ErrorCode::InvalidInput, "frame and mesh do not match");
@@ -278,7 +281,7 @@ TEST_CASE("partition: bad inputs fail with clear messages") {
     noK.candidateCount = 0;
     fails(frame, {0, 1}, noK, ErrorCode::Usage, "k (candidate labels");
     // An empty mesh.
-    CHECK_THROWS_AS(partitionSurface(TriMesh{}, frame, {0, 1}, {}, RunContext::silent()), Error);
+    CHECK_THROWS_AS(partitionSurface(TriMesh{}, frame, {0, 1}, Fabrication{}, {}, RunContext::silent()), Error);
 }
 
 TEST_CASE("partition: partitions that fit at a high w_smoothness are kept while the others are cut again") {
@@ -288,14 +291,15 @@ TEST_CASE("partition: partitions that fit at a high w_smoothness are kept while 
     const partition::test::MeshMm bunny = partition::test::loadMeshMm(zomefab::test::dataPath("bunny_npm_3674.stl"), 300.0, true);
     const partition::test::LatticeFrame frame = partition::test::makeLatticeFrame(bunny.mesh, 12.0);
     PartitionOptions o;
-    o.printerMm = {120, 120, 120};
-    const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, o, RunContext::silent());
+    Fabrication fab;
+    fab.printerMm = {120, 120, 120};
+    const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent());
     checkResult(bunny.mesh, r);
 
     // The first step alone: its labelling, and which of its regions fit the printer.
     PartitionOptions firstOnly = o;
     firstOnly.smoothnessMin = o.smoothnessStart;
-    const PartitionResult r10 = partitionSurface(bunny.mesh, frame.structure, frame.outermost, firstOnly, RunContext::silent());
+    const PartitionResult r10 = partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, firstOnly, RunContext::silent());
     REQUIRE(r10.schedule.size() == 1);
     const FaceGraph g = buildFaceGraph(bunny.mesh);
     std::vector<uint32_t> compOf;
@@ -306,7 +310,7 @@ TEST_CASE("partition: partitions that fit at a high w_smoothness are kept while 
     std::vector<char> fits(compCount);
     size_t fitCount = 0, fitFaces = 0;
     for (uint32_t c = 0; c < compCount; ++c) {
-        fits[c] = fitInPrinter(pts[c], o.printerMm, o.fitMarginMm).fits ? 1 : 0;
+        fits[c] = fitInPrinter(pts[c], fab.printerMm, fab.fitMarginMm).fits ? 1 : 0;
         fitCount += size_t(fits[c]);
     }
     // The case exercises the refinement: some regions fit at w_smoothness 10, some do not.
@@ -332,7 +336,7 @@ TEST_CASE("partition: partitions that fit at a high w_smoothness are kept while 
     // pieces.
     PartitionOptions whole = o;
     whole.refineOversizedOnly = false;
-    const PartitionResult rw = partitionSurface(bunny.mesh, frame.structure, frame.outermost, whole, RunContext::silent());
+    const PartitionResult rw = partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, whole, RunContext::silent());
     checkResult(bunny.mesh, rw);
     CHECK(changedFaces(rw) > 0);
     CHECK(r.pieces.size() < rw.pieces.size());

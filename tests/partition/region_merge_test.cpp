@@ -86,11 +86,12 @@ TEST_CASE("region merge: the small bunny in a small printer ends with fewer piec
         partition::test::loadMeshMm(zomefab::test::dataPath("bunny_npm_3674.stl"), 300.0, true);
     const partition::test::LatticeFrame frame = partition::test::makeLatticeFrame(bunny.mesh, 12.0);
     PartitionOptions o;
-    o.printerMm = {120, 120, 120};
-    const PartitionResult merged = partitionSurface(bunny.mesh, frame.structure, frame.outermost, o, RunContext::silent());
+    Fabrication fab;
+    fab.printerMm = {120, 120, 120};
+    const PartitionResult merged = partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent());
     PartitionOptions off = o;
     off.mergeSmallRegions = false;
-    const PartitionResult plain = partitionSurface(bunny.mesh, frame.structure, frame.outermost, off, RunContext::silent());
+    const PartitionResult plain = partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, off, RunContext::silent());
     CHECK(plain.regionMerges == 0);
     CHECK(merged.regionMerges > 0);
     CHECK(merged.pieces.size() < plain.pieces.size());

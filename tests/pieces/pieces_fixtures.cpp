@@ -34,7 +34,9 @@ sdf::LevelSet makeSphereShell(const Vec3d& c, double r, double t, double voxel) 
     o.interiorBandMm = t;
     const TriMesh sphere = zomefab::test::makeSphere(c, r, 96, 192);
     const sdf::LevelSet object = sdf::meshToLevelSet(sphere, o, RunContext::silent());
-    return sdf::makeShell(object, {t}, RunContext::silent());
+    Fabrication wall;
+    wall.wallMm = t;
+    return sdf::makeShell(object, wall, RunContext::silent());
 }
 
 zome::Structure makeCubeLattice(double maxRadiusMm) {
@@ -55,27 +57,39 @@ zome::Structure makeCubeLattice(double maxRadiusMm) {
     return s;
 }
 
-CellModel quadrantCells(double x, double z) {
-    CellModel c;
+namespace {
+
+partition::PartitionResult piecePerCell(partition::LinearCells cells) {
+    partition::PartitionResult r;
+    r.cells = std::move(cells);
+    r.pieces.resize(r.cells.cellCount());
+    for (size_t k = 0; k < r.pieces.size(); ++k) r.pieces[k].cells = {uint32_t(k)};
+    return r;
+}
+
+}  // namespace
+
+partition::PartitionResult quadrantCells(double x, double z) {
+    partition::LinearCells c;
     for (double sx : {1.0, -1.0})
         for (double sz : {1.0, -1.0}) {
             c.w.push_back({sx, 0, sz});
             c.b.push_back(-sx * x - sz * z);
         }
-    return c;
+    return piecePerCell(std::move(c));
 }
 
-CellModel halfSpaceCells(const Vec3d& n, double d) {
-    CellModel c;
+partition::PartitionResult halfSpaceCells(const Vec3d& n, double d) {
+    partition::LinearCells c;
     c.w = {n, scale(n, -1.0)};
     c.b = {-d, d};
-    return c;
+    return piecePerCell(std::move(c));
 }
 
-std::vector<PieceRequest> requestPerCell(const CellModel& cells) {
-    std::vector<PieceRequest> r(cells.cellCount());
-    for (size_t k = 0; k < r.size(); ++k) r[k].cells = {uint32_t(k)};
-    return r;
+Fabrication printerOf(const Vec3d& printerMm) {
+    Fabrication f;
+    f.printerMm = printerMm;
+    return f;
 }
 
 namespace {
@@ -128,7 +142,7 @@ void writeToolInputs(const std::string& dir) {
     writeFile(dir + "/shell.vdb", sdf::serializeVdb({shell}));
     const zome::Structure frame = makeCubeLattice(75.0 - 8.0 - 8.85 - 3.0);
     writeFile(dir + "/frame.json", zome::structureToJson(frame).dump(1));
-    const CellModel cells = quadrantCells(-5.3, 10.4);
+    const partition::LinearCells cells = quadrantCells(-5.3, 10.4).cells;
     auto partition = [&](const Transform4d& t) {
         nlohmann::json j;
         j["format"] = "zomefab.partition";

@@ -22,13 +22,13 @@ sdf::LevelSet makeSphereShell(const Vec3d& centerMm, double radiusMm, double she
 /// within @p maxRadiusMm of the origin, joined by B0 struts to their lattice neighbours.
 zome::Structure makeCubeLattice(double maxRadiusMm);
 
-/// Argmax cells cutting space along x = @p xMm and z = @p zMm (4 cells, frame mm): for signs
-/// (sx, sz) ∈ {±1}², w = (sx, 0, sz), b = −sx·x − sz·z.
-CellModel quadrantCells(double xMm, double zMm);
-/// Two cells cut by the plane n·x = d (n need not be unit): {n·x ≥ d} is cell 0.
-CellModel halfSpaceCells(const Vec3d& n, double d);
-/// One request per cell.
-std::vector<PieceRequest> requestPerCell(const CellModel& cells);
+/// A partition whose argmax cells cut space along x = @p xMm and z = @p zMm (4 cells, frame mm):
+/// for signs (sx, sz) ∈ {±1}², w = (sx, 0, sz), b = −sx·x − sz·z; one piece per cell.
+partition::PartitionResult quadrantCells(double xMm, double zMm);
+/// Two cells cut by the plane n·x = d (n need not be unit): {n·x ≥ d} is cell 0; one piece each.
+partition::PartitionResult halfSpaceCells(const Vec3d& n, double d);
+/// A Fabrication with the printer @p printerMm.
+Fabrication printerOf(const Vec3d& printerMm);
 
 /// Is @p p inside the closed mesh? (ray parity along a fixed skew direction)
 bool isInsideMesh(const TriMesh& mesh, const Vec3d& p);

@@ -94,8 +94,8 @@ void checkClosedAndFits(const Pieces& result) {
 }  // namespace
 
 TEST_CASE("pieces: the union of the pieces is the shell (volume and sampled points)") {
-    const CellModel cells = quadrantCells(-15.3, 20.4);
-    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells),
+    const partition::PartitionResult cells = quadrantCells(-15.3, 20.4);
+    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{},
                                      plainOptions(), RunContext::silent());
     REQUIRE(result.pieces.size() == 4);
     checkClosedAndFits(result);
@@ -135,12 +135,12 @@ TEST_CASE("pieces: the union of the pieces is the shell (volume and sampled poin
 }
 
 TEST_CASE("pieces: tenons use free blue holes, end at the ball's face and clear the frame") {
-    const CellModel cells = quadrantCells(-15.3, 20.4);
+    const partition::PartitionResult cells = quadrantCells(-15.3, 20.4);
     PiecesOptions o;
     o.label.isEnabled = false;
     o.tenons.maxTiltDeg = 35;
     const Pieces result =
-        makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells), o, RunContext::silent());
+        makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{}, o, RunContext::silent());
     checkClosedAndFits(result);
     const zome::Structure& f = frame();
     const double ballRadius = f.scale().ballRadiusMm();
@@ -203,8 +203,8 @@ TEST_CASE("pieces: tenons use free blue holes, end at the ball's face and clear 
 
 TEST_CASE("pieces: slivers are merged into a neighbour, never dropped") {
     // A plane 1.5 mm inside the outer surface cuts off a ~700 mm³ cap of the wall.
-    const CellModel cells = halfSpaceCells({1, 0, 0}, kRadius - 1.5);
-    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells),
+    const partition::PartitionResult cells = halfSpaceCells({1, 0, 0}, kRadius - 1.5);
+    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{},
                                      plainOptions(), RunContext::silent());
     REQUIRE(result.pieces.size() == 1);
     CHECK(result.sliversMerged == 1);
@@ -216,7 +216,7 @@ TEST_CASE("pieces: slivers are merged into a neighbour, never dropped") {
     // With no minimum the cap is a piece of its own.
     PiecesOptions keep = plainOptions();
     keep.minPieceVolumeMm3 = 0;
-    const Pieces two = makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells), keep,
+    const Pieces two = makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{}, keep,
                                   RunContext::silent());
     REQUIRE(two.pieces.size() == 2);
     CHECK(two.pieces[0].volumeMm3 + two.pieces[1].volumeMm3 == doctest::Approx(shellVolume()).epsilon(0.01));
@@ -227,18 +227,18 @@ TEST_CASE("pieces: a cell shared by two requests and a cell no request names") {
     // Cells: 0 = x ≥ 0 and 1 = x < 0. Both requests name cell 0 (its shell part is connected, so it
     // goes whole to the request whose surface box holds most of it); no request names cell 1,
     // whose shell part joins its neighbour, whatever its size.
-    const CellModel cells = halfSpaceCells({1, 0, 0}, 0.0);
-    std::vector<PieceRequest> requests(2);
-    requests[0].cells = {0};
-    requests[0].boundsMm.expand({50, 50, 50});
-    requests[0].boundsMm.expand({60, 60, 60});
-    requests[1].cells = {0};
-    requests[1].boundsMm.expand({0, -100, -100});
-    requests[1].boundsMm.expand({100, 100, 100});
+    partition::PartitionResult cells = halfSpaceCells({1, 0, 0}, 0.0);
+    cells.pieces.resize(2);
+    cells.pieces[0].cells = {0};
+    cells.pieces[0].boundsMm.expand({50, 50, 50});
+    cells.pieces[0].boundsMm.expand({60, 60, 60});
+    cells.pieces[1].cells = {0};
+    cells.pieces[1].boundsMm.expand({0, -100, -100});
+    cells.pieces[1].boundsMm.expand({100, 100, 100});
     RunContext context;
     PiecesOptions o = plainOptions();
-    o.printerMm = {250, 250, 250};
-    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells, requests, o, context);
+    const Fabrication fab = printerOf({250, 250, 250});
+    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells, fab, o, context);
     REQUIRE(result.pieces.size() == 1);
     CHECK(result.pieces[0].requests == std::vector<uint32_t>{1});
     CHECK(result.pieces[0].cells == std::vector<uint32_t>{0, 1});
@@ -251,11 +251,11 @@ TEST_CASE("pieces: a cell shared by two requests and a cell no request names") {
 }
 
 TEST_CASE("pieces: a piece larger than the printer is an error of the partition") {
-    const CellModel cells = halfSpaceCells({0, 0, 1}, 0.0);  // two 200 × 200 × 100 mm halves
+    const partition::PartitionResult cells = halfSpaceCells({0, 0, 1}, 0.0);  // two 200 × 200 × 100 mm halves
     PiecesOptions o = plainOptions();
-    o.printerMm = {120, 120, 120};
+    const Fabrication fab = printerOf({120, 120, 120});
     try {
-        makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells), o, RunContext::silent());
+        makePieces(shell(), frame(), Transform4d::identity(), cells, fab, o, RunContext::silent());
         FAIL("no error");
     } catch (const Error& e) {
         CHECK(e.code() == ErrorCode::ProcessingFailed);
@@ -265,31 +265,31 @@ TEST_CASE("pieces: a piece larger than the printer is an error of the partition"
 }
 
 TEST_CASE("pieces: bad inputs and options") {
-    const CellModel cells = halfSpaceCells({0, 0, 1}, 0.0);
-    auto codeOf = [&](const CellModel& c, const std::vector<PieceRequest>& r, const PiecesOptions& o,
+    const partition::PartitionResult cells = halfSpaceCells({0, 0, 1}, 0.0);
+    auto codeOf = [&](const partition::PartitionResult& c, const PiecesOptions& o,
                       const Transform4d& t = Transform4d::identity()) {
         try {
-            makePieces(shell(), frame(), t, c, r, o, RunContext::silent());
+            makePieces(shell(), frame(), t, c, Fabrication{}, o, RunContext::silent());
         } catch (const Error& e) {
             return int(e.code());
         }
         return -1;
     };
-    std::vector<PieceRequest> bad(1);
-    bad[0].cells = {5};
-    CHECK(codeOf(cells, bad, plainOptions()) == int(ErrorCode::InvalidInput));
-    CHECK(codeOf(cells, requestPerCell(cells), plainOptions(), Transform4d::scaleTranslate(2.0, {0, 0, 0})) ==
-          int(ErrorCode::InvalidInput));
-    CellModel empty;
-    CHECK(codeOf(empty, {}, plainOptions()) == int(ErrorCode::InvalidInput));
+    partition::PartitionResult bad = cells;
+    bad.pieces.resize(1);
+    bad.pieces[0].cells = {5};
+    CHECK(codeOf(bad, plainOptions()) == int(ErrorCode::InvalidInput));
+    CHECK(codeOf(cells, plainOptions(), Transform4d::scaleTranslate(2.0, {0, 0, 0})) == int(ErrorCode::InvalidInput));
+    partition::PartitionResult empty;
+    CHECK(codeOf(empty, plainOptions()) == int(ErrorCode::InvalidInput));
     PiecesOptions o = plainOptions();
     o.adaptivity = 1.5;
-    CHECK(codeOf(cells, requestPerCell(cells), o) == int(ErrorCode::Usage));
+    CHECK(codeOf(cells, o) == int(ErrorCode::Usage));
     // Tenon pegs need a fine enough voxel: a 2 mm shell is too coarse.
     const sdf::LevelSet coarse = makeSphereShell({0, 0, 0}, 60.0, 8.0, 2.0);
     PiecesOptions withTenons;
     try {
-        makePieces(coarse, frame(), Transform4d::identity(), cells, requestPerCell(cells), withTenons, RunContext::silent());
+        makePieces(coarse, frame(), Transform4d::identity(), cells, Fabrication{}, withTenons, RunContext::silent());
         FAIL("no error");
     } catch (const Error& e) {
         CHECK(e.code() == ErrorCode::Usage);
@@ -298,11 +298,11 @@ TEST_CASE("pieces: bad inputs and options") {
 }
 
 TEST_CASE("pieces: the engraved number is cut into the inner surface") {
-    const CellModel cells = halfSpaceCells({0, 0, 1}, 10.0);
+    const partition::PartitionResult cells = halfSpaceCells({0, 0, 1}, 10.0);
     PiecesOptions o;
     o.tenons.maxTiltDeg = 35;
     const Pieces result =
-        makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells), o, RunContext::silent());
+        makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{}, o, RunContext::silent());
     checkClosedAndFits(result);
     size_t labelled = 0;
     for (const Piece& p : result.pieces) {
@@ -348,11 +348,11 @@ TEST_CASE("pieces: a frame rotated about the vertical and shifted") {
     // The shell stays centred at the origin of the grid; the frame (made around its own origin)
     // is placed by frameToGrid, so keep it well inside: a smaller lattice.
     const zome::Structure small = makeCubeLattice(60.0);
-    const CellModel cells = quadrantCells(-15.3, 20.4);  // in the frame's mm
+    const partition::PartitionResult cells = quadrantCells(-15.3, 20.4);  // in the frame's mm
     PiecesOptions o;
     o.label.isEnabled = false;
     o.tenons.maxTiltDeg = 35;
-    const Pieces result = makePieces(shell(), small, frameToGrid, cells, requestPerCell(cells), o, RunContext::silent());
+    const Pieces result = makePieces(shell(), small, frameToGrid, cells, Fabrication{}, o, RunContext::silent());
     REQUIRE(result.pieces.size() == 4);
     checkClosedAndFits(result);
     size_t total = 0;
@@ -394,12 +394,12 @@ TEST_CASE("pieces: a frame rotated about the vertical and shifted") {
 }
 
 TEST_CASE("pieces: the same result with 1 and 2 threads, and the written files") {
-    const CellModel cells = quadrantCells(-15.3, 20.4);
+    const partition::PartitionResult cells = quadrantCells(-15.3, 20.4);
     PiecesOptions o;
     o.tenons.maxTiltDeg = 35;
     auto run = [&](int threads) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-        return makePieces(shell(), frame(), Transform4d::identity(), cells, requestPerCell(cells), o, RunContext::silent());
+        return makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{}, o, RunContext::silent());
     };
     const Pieces one = run(1), two = run(2);
     REQUIRE(one.pieces.size() == two.pieces.size());

@@ -174,10 +174,10 @@ TEST_CASE("zf-pieces: the real chain zf-sdf, zf-shell, zf-frame, zf-partition, z
         }
     test::ScratchDir dir("zomefab-pieces-chain");
     const std::string bunny = test::dataPath("bunny_npm_3674.stl");
-    REQUIRE(test::runShell(test::toolPath("zf-sdf") + " " + bunny + " --height-mm 250 --up y --shell-depth-mm 10 -q -o " +
+    REQUIRE(test::runShell(test::toolPath("zf-sdf") + " " + bunny + " --height-mm 250 --up y --shell-mm 10 -q -o " +
                 dir.file("bunny.vdb")) == 0);
     REQUIRE(test::runShell(test::toolPath("zf-shell") + " " + dir.file("bunny.vdb") + " --shell-mm 10 -q -o " + dir.file("shell.vdb")) == 0);
-    REQUIRE(test::runShell(test::toolPath("zf-frame") + " " + dir.file("bunny.vdb") + " --d-min-mm 10 -q -o " + dir.file("frame.json")) == 0);
+    REQUIRE(test::runShell(test::toolPath("zf-frame") + " " + dir.file("bunny.vdb") + " --frame-clearance-mm 10 -q -o " + dir.file("frame.json")) == 0);
     REQUIRE(test::runShell(test::toolPath("zf-partition") + " " + bunny + " " + dir.file("frame.json") + " -q -o " +
                 dir.file("partition.json")) == 0);
     REQUIRE(test::runShell(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " + dir.file("frame.json") + " " +

@@ -24,6 +24,7 @@
 #include "zomefab/pieces/pieces_io.h"
 #include "zomefab/pipeline/pipeline.h"
 #include "zomefab/report/cost_report.h"
+#include "zomefab/report/run_report.h"
 #include "zomefab/zome/parts.h"
 #include "zomefab/zome/structure_json.h"
 
@@ -40,7 +41,7 @@ double relativeError(double estimate, double reference) { return std::abs(estima
 struct DemoRun {
     test::ScratchDir dir{"zomefab-long"};
     pipeline::RunOptions options;
-    pipeline::RunResult result;
+    report::RunRecord result;
     json report;
     std::string out;
 
@@ -49,7 +50,7 @@ struct DemoRun {
         options.scale.up = mesh::UpAxis::Y;
         const TriMesh mesh = readMesh(test::dataPath("bunny_cgal_75k.stl"));
         result = pipeline::runPipeline(mesh, "bunny_cgal_75k.stl", options, RunContext::silent());
-        report = pipeline::runReportJson(result, options, RunContext::silent());
+        report = report::runReportJson(result, RunContext::silent());
         out = dir.file("out");
         pipeline::writeRunOutputs(result, options, report, out);
     }
@@ -120,7 +121,7 @@ TEST_CASE("long: pieces are closed, fit the printer, and sum to the shell's volu
         volumeMm3 += m.volume;
         for (int a = 0; a < 3; ++a) {
             CHECK(m.bounds.min[size_t(a)] >= -1e-3);
-            CHECK(m.bounds.max[size_t(a)] <= d.options.partition.printerMm[size_t(a)] + 1e-3);
+            CHECK(m.bounds.max[size_t(a)] <= d.options.fabrication.printerMm[size_t(a)] + 1e-3);
         }
         CHECK(m.bounds.min[2] == doctest::Approx(0).epsilon(1e-6));  // on the bed
         if (hasAdmesh) {
@@ -191,7 +192,7 @@ TEST_CASE("long: the estimator agrees with PrusaSlicer within 15 % on the pieces
     const DemoRun& d = demo();
     const report::CostOptions& cost = d.options.cost;
     const std::vector<TriMesh> baseline =
-        report::octreeParts(d.result.scaled.mesh, d.options.partition.printerMm, 10, RunContext::silent());
+        report::octreeParts(d.result.scaled.mesh, d.options.fabrication.printerMm, 10, RunContext::silent());
     REQUIRE(baseline.size() == d.result.cost.baselinePartCount);
     struct Sample {
         std::string what;

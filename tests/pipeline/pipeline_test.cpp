@@ -10,6 +10,7 @@
 #include "zomefab/io/file_io.h"
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/pipeline/pipeline.h"
+#include "zomefab/report/run_report.h"
 #include "zomefab/zome/parts.h"
 #include "zomefab/zome/structure_json.h"
 
@@ -25,7 +26,7 @@ pipeline::RunOptions smallRunOptions() {
     o.field.voxelMm = 1.5;  // coarse for speed, fine enough for the tenon pegs (≤ 1.54 mm)
     o.frame.anneal.maxIterations = 20000;
     o.frame.chains = 2;
-    o.frame.seed = 7;
+    o.fabrication.seed = 7;
     return o;
 }
 
@@ -34,14 +35,14 @@ pipeline::RunOptions smallRunOptions() {
 TEST_CASE("pipeline: the small bunny end to end, outputs consistent with each other") {
     const TriMesh mesh = readMesh(test::dataPath("bunny_npm_3674.stl"));
     const pipeline::RunOptions options = smallRunOptions();
-    const pipeline::RunResult result = pipeline::runPipeline(mesh, "bunny", options, RunContext::silent());
+    const report::RunRecord result = pipeline::runPipeline(mesh, "bunny", options, RunContext::silent());
     CHECK(result.scaled.sizeMm[2] == doctest::Approx(250).epsilon(1e-4));
     REQUIRE(result.frame.structure.ballCount() > 0);
     CHECK(!result.partition.pieces.empty());
 
     test::ScratchDir dir;
     const std::string out = dir.file("run");
-    const nlohmann::json report = pipeline::runReportJson(result, options, RunContext::silent());
+    const nlohmann::json report = report::runReportJson(result, RunContext::silent());
     const auto files = pipeline::writeRunOutputs(result, options, report, out);
     for (const std::string& f : files) CHECK(fs::exists(fs::path(out) / f));
     CHECK(files == std::vector<std::string>{"assembly.md", "cost.md", "frame.json", "frame.vef", "partition.json",
@@ -75,9 +76,9 @@ TEST_CASE("pipeline: same seed gives byte-identical frame and partition files") 
     test::ScratchDir dir;
     std::string frames[2], partitions[2];
     for (int i = 0; i < 2; ++i) {
-        const pipeline::RunResult r = pipeline::runPipeline(mesh, "bunny", options, RunContext::silent());
+        const report::RunRecord r = pipeline::runPipeline(mesh, "bunny", options, RunContext::silent());
         const std::string out = dir.file("run" + std::to_string(i));
-        pipeline::writeRunOutputs(r, options, pipeline::runReportJson(r, options, RunContext::silent()), out);
+        pipeline::writeRunOutputs(r, options, report::runReportJson(r, RunContext::silent()), out);
         frames[i] = readInputBytes(out + "/frame.json");
         partitions[i] = readInputBytes(out + "/partition.json");
     }

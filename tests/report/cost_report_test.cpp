@@ -60,7 +60,7 @@ TEST_CASE("cost_report: assembly time is 32 s per part, fitted to the paper's Ta
 TEST_CASE("cost_report: hollow and solid cases against the octree baseline") {
     const SphereCase sphere;
     const zome::PartsList parts = bunnyParts();
-    const CostReport r = costReport(sphere.object, sphere.pieces, parts);
+    const CostReport r = costReport(sphere.object, test::pointersTo(sphere.pieces), parts, Fabrication{});
     REQUIRE(r.cases.size() == 2);
     CHECK(r.pieceCount == 8);
     CHECK(r.baselinePartCount == 8);  // 300 mm on a 200 mm printer: one octree level
@@ -116,19 +116,19 @@ TEST_CASE("cost_report: a part the slicer fails on is estimated instead, with a 
             if (level == LogLevel::Warning) warnings.push_back(m);
         },
         nullptr);
-    const CostReport r = costReport(object, pieces, bunnyParts(), o, context);
+    const CostReport r = costReport(object, test::pointersTo(pieces), bunnyParts(), Fabrication{}, o, context);
     CHECK(r.slicerFallbacks ==
           std::vector<std::string>{"hollow piece 0 at 20%", "hollow baseline part 0 at 20%",
                                    "solid piece 0 at 100%", "solid baseline part 0 at 100%"});
     REQUIRE(warnings.size() == 4);
     CHECK(warnings[0].find("false failed on hollow piece 0 at 20%") != std::string::npos);
-    const CostReport model = costReport(object, pieces, bunnyParts());
+    const CostReport model = costReport(object, test::pointersTo(pieces), bunnyParts(), Fabrication{});
     CHECK(r.cases[0].zomefab.print.seconds == model.cases[0].zomefab.print.seconds);
     CHECK(costReportToJson(r)["slicer_fallbacks"].size() == 4);
     // A slicer that is not there at all is a usage error, before any work.
     o.slicer.executable = "/nonexistent/prusa-slicer";
     CHECK_THROWS_WITH_AS(
-        costReport(object, pieces, bunnyParts(), o),
+        costReport(object, test::pointersTo(pieces), bunnyParts(), Fabrication{}, o),
         "--slicer /nonexistent/prusa-slicer: not installed or not executable (Debian package prusa-slicer)",
         Error);
 }
@@ -138,14 +138,15 @@ TEST_CASE("cost_report: filament options change cost and length, not time") {
     CostOptions cheap;
     cheap.filament.usdPerM = 0.28;
     cheap.filament.diameterMm = 1.75;
-    const CostReport a = costReport(sphere.object, sphere.pieces, bunnyParts());
-    const CostReport b = costReport(sphere.object, sphere.pieces, bunnyParts(), cheap);
+    const CostReport a = costReport(sphere.object, test::pointersTo(sphere.pieces), bunnyParts(), Fabrication{});
+    const CostReport b = costReport(sphere.object, test::pointersTo(sphere.pieces), bunnyParts(), Fabrication{}, cheap);
     const double area = (2.85 * 2.85) / (1.75 * 1.75);
     CHECK(b.cases[0].zomefab.filament.lengthM == doctest::Approx(a.cases[0].zomefab.filament.lengthM * area));
     CHECK(b.cases[0].zomefab.filament.costUsd ==
           doctest::Approx(a.cases[0].zomefab.filament.costUsd * area * 0.5));
     CHECK(b.cases[0].zomefab.print.seconds == a.cases[0].zomefab.print.seconds);
     CostOptions bad;
-    bad.printerMm = {200, -1, 200};
-    CHECK_THROWS_AS(costReport(sphere.object, sphere.pieces, bunnyParts(), bad), Error);
+    Fabrication badPrinter;
+    badPrinter.printerMm = {200, -1, 200};
+    CHECK_THROWS_AS(costReport(sphere.object, test::pointersTo(sphere.pieces), bunnyParts(), badPrinter, bad), Error);
 }

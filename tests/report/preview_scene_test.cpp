@@ -76,7 +76,8 @@ TEST_CASE("preview_scene: strut cross-sections have the Zome model's sizes") {
 TEST_CASE("preview_scene: pieces, one instanced ball mesh, one mesh per strut kind") {
     const zome::Structure frame = colourFrame();
     PreviewInput input;
-    input.pieces = {makeBox({-30, -30, -30}, {0, 0, 0}), makeSphere({80, 0, 0}, 20, 12, 24)};
+    const std::vector<TriMesh> meshes{makeBox({-30, -30, -30}, {0, 0, 0}), makeSphere({80, 0, 0}, 20, 12, 24)};
+    input.pieces = test::pointersTo(meshes);
     input.pieceNames = {"piece-00", "piece-01"};
     input.frame = &frame;
     input.extras = {{"run", "test"}, {"format", "must not override"}};
@@ -150,7 +151,8 @@ TEST_CASE("preview_scene: frame only, pieces only, and bad input") {
     CHECK(a.meshes.size() == 5);
 
     PreviewInput piecesOnly;
-    piecesOnly.pieces = {makeBox({0, 0, 0}, {1, 1, 1})};
+    const TriMesh box = makeBox({0, 0, 0}, {1, 1, 1});
+    piecesOnly.pieces = {&box};
     const GlbScene b = buildPreviewScene(piecesOnly);
     CHECK(findNode(b, "piece-00") != nullptr);
     CHECK(!b.extras.contains("parts"));
@@ -167,6 +169,7 @@ TEST_CASE("preview_scene: frame only, pieces only, and bad input") {
     piecesOnly.pieceNames = {"a", "b"};
     CHECK_THROWS_AS(buildPreviewScene(piecesOnly), Error);
     PreviewInput empty;
-    empty.pieces = {TriMesh{}};
+    const TriMesh nothing;
+    empty.pieces = {&nothing};
     CHECK_THROWS_AS(buildPreviewScene(empty), Error);
 }

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file The print estimator's volume model, filament conversions and the octree baseline.
+#include "zomefab/core/fabrication.h"
 #include "zomefab/report/print_estimate.h"
 
 #include <doctest/doctest.h>
@@ -95,11 +96,11 @@ TEST_CASE("print_estimate: invalid settings are usage errors") {
 }
 
 TEST_CASE("print_estimate: fitsPrinter tries the axis permutations") {
-    CHECK(fitsPrinter({250, 100, 100}, {100, 100, 250}));
-    CHECK(fitsPrinter({200, 200, 200}, {200, 200, 200}));
-    CHECK_FALSE(fitsPrinter({201, 10, 10}, {200, 200, 200}));
-    CHECK(fitsPrinter({150, 150, 10}, {100, 200, 200}));  // 10 mm along the 100 mm side
-    CHECK_FALSE(fitsPrinter({150, 150, 150}, {100, 200, 200}));
+    CHECK(boxFitsPrinter({250, 100, 100}, {100, 100, 250}));
+    CHECK(boxFitsPrinter({200, 200, 200}, {200, 200, 200}));
+    CHECK_FALSE(boxFitsPrinter({201, 10, 10}, {200, 200, 200}));
+    CHECK(boxFitsPrinter({150, 150, 10}, {100, 200, 200}));  // 10 mm along the 100 mm side
+    CHECK_FALSE(boxFitsPrinter({150, 150, 150}, {100, 200, 200}));
 }
 
 TEST_CASE("print_estimate: parts are turned onto their largest flat face") {
@@ -137,7 +138,7 @@ TEST_CASE("print_estimate: the octree baseline cuts until every part fits, and k
         double volume = 0.0;
         for (const TriMesh& p : parts) {
             CHECK(isClosedOriented(p));
-            CHECK(fitsPrinter(boundingBox(p).size(), {200, 200, 200}));
+            CHECK(boxFitsPrinter(boundingBox(p).size(), {200, 200, 200}));
             volume += signedVolume(p);
         }
         CHECK(volume == doctest::Approx(3e6).epsilon(1e-6));
@@ -152,7 +153,7 @@ TEST_CASE("print_estimate: the octree baseline cuts until every part fits, and k
         double volume = 0.0;
         for (const TriMesh& p : parts) {
             CHECK(isClosedOriented(p));
-            CHECK(fitsPrinter(boundingBox(p).size(), {200, 200, 200}));
+            CHECK(boxFitsPrinter(boundingBox(p).size(), {200, 200, 200}));
             volume += signedVolume(p);
         }
         CHECK(volume == doctest::Approx(signedVolume(bunny)).epsilon(1e-4));

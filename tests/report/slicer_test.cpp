@@ -107,8 +107,8 @@ TEST_CASE("slicer: the cost report can take its numbers from PrusaSlicer") {
     parts.struts[0][0] = 12;
     CostOptions o;
     o.source = EstimateSource::PrusaSlicer;
-    const CostReport real = costReport(object, pieces, parts, o);
-    const CostReport model = costReport(object, pieces, parts);
+    const CostReport real = costReport(object, test::pointersTo(pieces), parts, Fabrication{}, o);
+    const CostReport model = costReport(object, test::pointersTo(pieces), parts, Fabrication{});
     CHECK(costReportToJson(real)["source"] == "prusa-slicer");
     for (size_t c = 0; c < 2; ++c) {
         CHECK(real.cases[c].baseline.print.parts == 1);

@@ -117,6 +117,6 @@ TEST_CASE("zf-preview: pieces.json pieces go back from the printer to the frame'
     CHECK(runCapture(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces.json") + " -o " +
                   dir.file("bad.glb") + " 2>&1",
               &err) == 2);
-    CHECK(err.find("pieces.json: pieces[0] has no file") != std::string::npos);
+    CHECK(err.find("pieces.json: pieces[0]: needs \"file\"") != std::string::npos);
     CHECK(!std::filesystem::exists(dir.file("bad.glb")));
 }

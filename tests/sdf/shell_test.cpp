@@ -56,7 +56,7 @@ TEST_CASE("shell: a sphere's shell is two closed walls shellMm apart") {
     MeshToLevelSetOptions options;
     options.interiorBandMm = 16.0;
     const LevelSet object = meshToLevelSet(sphere, options, RunContext::silent());
-    const LevelSet shell = makeShell(object, {}, RunContext::silent());  // default: 16 mm
+    const LevelSet shell = makeShell(object, Fabrication{}, RunContext::silent());  // default: 16 mm
     CHECK(shell.info().name == "shell");
     CHECK(shell.info().shellMm == 16.0);
     const double voxel = shell.info().voxelMm;
@@ -82,14 +82,12 @@ TEST_CASE("shell: a sphere's shell is two closed walls shellMm apart") {
 TEST_CASE("shell: the bunny's wall is shellMm thick and closed") {
     // The low-resolution bunny at 250 mm, 1 mm voxels, an 8 mm wall: seconds, and the ears stay hollow.
     const TriMesh bunny = bunnyMm("bunny_npm_3674.stl", 250.0);
-    ObjectFieldOptions options;
-    options.shellDepthMm = 8.0;
     MeshToLevelSetOptions levelSet;
-    levelSet.interiorBandMm = options.shellDepthMm;
+    levelSet.interiorBandMm = 8.0;
     const LevelSet object = meshToLevelSet(bunny, levelSet, RunContext::silent());
-    ShellOptions shellOptions;
-    shellOptions.shellMm = 8.0;
-    const LevelSet shell = makeShell(object, shellOptions, RunContext::silent());
+    Fabrication wall;
+    wall.wallMm = 8.0;
+    const LevelSet shell = makeShell(object, wall, RunContext::silent());
     const TriMesh mesh = levelSetToMesh(shell, {}, RunContext::silent());
     const ShellParts parts = splitShell(mesh);
     CHECK(parts.edges.components == 2);
@@ -113,12 +111,12 @@ TEST_CASE("shell: options outside the allowed range are usage errors") {
     MeshToLevelSetOptions options;
     options.interiorBandMm = 5.0;
     const LevelSet object = meshToLevelSet(sphere, options, RunContext::silent());
-    ShellOptions shell;
-    shell.shellMm = 0.5;
+    Fabrication shell;
+    shell.wallMm = 0.5;
     CHECK(test::errorCodeOf([&] { makeShell(object, shell, RunContext::silent()); }) == ErrorCode::Usage);
-    shell.shellMm = 6.0;  // deeper than the 5 mm band
+    shell.wallMm = 6.0;  // deeper than the 5 mm band
     CHECK(test::errorCodeOf([&] { makeShell(object, shell, RunContext::silent()); }) == ErrorCode::Usage);
-    shell.shellMm = 5.0;
+    shell.wallMm = 5.0;
     CHECK(makeShell(object, shell, RunContext::silent()).activeVoxelCount() > 0);
 }
 
@@ -128,8 +126,8 @@ TEST_CASE("shell: a thin object gives a solid piece where it is thinner than two
     MeshToLevelSetOptions options;
     options.interiorBandMm = 4.0;
     const LevelSet object = meshToLevelSet(slab, options, RunContext::silent());
-    ShellOptions shell;
-    shell.shellMm = 4.0;
+    Fabrication shell;
+    shell.wallMm = 4.0;
     const TriMesh mesh =
         levelSetToMesh(makeShell(object, shell, RunContext::silent()), {}, RunContext::silent());
     CHECK(test::edgeReport(mesh).components == 1);

@@ -17,7 +17,7 @@ using namespace zomefab;
 namespace {
 
 const std::string kBunny = test::dataPath("bunny_npm_3674.stl");
-const std::string kScale = " --height-mm 150 --up y --shell-depth-mm 8 -q";
+const std::string kScale = " --height-mm 150 --up y --shell-mm 8 -q";
 
 }  // namespace
 

@@ -5,7 +5,9 @@
 #include <sstream>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 #include "zomefab/io/file_io.h"
+#include "zomefab/zome/structure_json.h"
 
 namespace zomefab::cli {
 
@@ -45,6 +47,216 @@ std::vector<uint32_t> readSalientFaceList(const std::string& path, size_t faceCo
         faces.push_back(v.get<uint32_t>());
     }
     return faces;
+}
+
+zome::Structure readFrame(const std::string& path, Transform4d* transformMm) {
+    const std::string bytes = readInputBytes(path);
+    try {
+        return zome::structureFromJsonText(bytes, {}, {}, transformMm);
+    } catch (const Error& e) {
+        throw e.withFile(path);
+    }
+}
+
+partition::PartitionFile readPartition(const std::string& path) {
+    const nlohmann::json j = nlohmann::json::parse(readInputBytes(path), nullptr, false);
+    if (j.is_discarded()) throw Error(ErrorCode::InvalidInput, "invalid JSON", path);
+    try {
+        return partition::partitionFromJson(j);
+    } catch (const Error& e) {
+        throw e.withFile(path);
+    } catch (const nlohmann::json::exception& e) {
+        throw Error(ErrorCode::InvalidInput, std::string("malformed partition file: ") + e.what(), path);
+    }
+}
+
+// --- what the user is making ----------------------------------------------------------------------
+
+void FabricationCli::addTo(CLI::App& app, unsigned parts) {
+    Fabrication& f = fabrication;
+    if (parts & kPrinter) {
+        app.add_option("--printer-mm", printer, "Printer build volume WxDxH in mm")
+            ->default_str(formatNumbers("%gx%gx%g", f.printerMm[0], f.printerMm[1], f.printerMm[2]));
+        app.add_option("--fit-margin-mm", f.fitMarginMm, "Grow each side of a piece's box by this before the fit test")
+            ->capture_default_str();
+    }
+    if (parts & kWall)
+        app.add_option("--shell-mm", f.wallMm, "Shell wall thickness in mm (paper: dMin = 16)")->capture_default_str();
+    if (parts & kFrameClearance) {
+        app.add_option("--frame-clearance-mm", f.frameClearanceMm,
+                       "Forbidden zone dMin: no ball or strut closer to the surface (mm)")
+            ->capture_default_str();
+        app.add_option("--b0-mm", f.b0Mm, "Length of the B0 strut, centre to centre (the kit's scale; dMax = b0)")
+            ->capture_default_str();
+    }
+}
+
+Fabrication FabricationCli::resolve(uint64_t seed) const {
+    Fabrication f = fabrication;
+    if (!printer.empty()) f.printerMm = parsePrinterMm(printer);
+    f.seed = seed;
+    checkFabrication(f);
+    return f;
+}
+
+// --- input and level sets -------------------------------------------------------------------------
+
+void ValidateCli::addTo(CLI::App& app) {
+    app.add_flag("--repair", options.repair, "Close small holes of an open mesh");
+}
+
+void FieldCli::addTo(CLI::App& app) {
+    app.add_option("--voxel-mm", options.voxelMm,
+                   formatNumbers("Voxel of the object and shell level sets (at most %.2f for the tenon pegs)",
+                                 pieces::maxVoxelForPegsMm(pieces::TenonOptions{})))
+        ->capture_default_str();
+    app.add_option("--field-voxel-mm", options.fieldVoxelMm, "Voxel size of the interior grid (frame optimisation)")
+        ->capture_default_str();
+}
+
+// --- frame (paper §4) -----------------------------------------------------------------------------
+
+void FrameCli::addTo(CLI::App& app) {
+    frame::FrameOptions& o = options;
+    app.add_option("--chains", o.chains, "Annealing chains run in parallel; the best is kept")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 4096));
+    app.add_option("--iterations", o.anneal.maxIterations, "Annealing iterations per chain (0 = until T < --t-end)")
+        ->capture_default_str();
+    app.add_option("--time-limit", o.anneal.timeLimitSeconds,
+                   "Wall-clock budget per chain in seconds (0 = none; makes the result timing-dependent)")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    app.add_option("--t-init", o.anneal.initialTemperature, "Initial temperature T_init")->capture_default_str();
+    app.add_option("--t-end", o.anneal.finalTemperature, "Stop when T < T_end (0 = only the budgets stop)")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    app.add_option("--cooling", o.anneal.coolingFactor, "Cooling factor C")->capture_default_str();
+    app.add_option("--cooling-interval", o.anneal.coolingIntervalIterations, "Iterations between two cooling steps")
+        ->capture_default_str();
+    app.add_option("--w-fid", o.energy.fidelityWeight, "Weight of E_fid")->capture_default_str();
+    app.add_option("--w-reg", o.energy.regularityWeight, "Weight of E_reg")->capture_default_str();
+    app.add_option("--w-val", o.energy.valenceWeight, "Weight of E_val")->capture_default_str();
+    app.add_option("--w-sim", o.energy.simplicityWeight, "Weight of E_sim")->capture_default_str();
+    app.add_option("--tau", o.target.fixedTargetCount, "Fix the target item count τ (0 = estimate it)")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    app.add_option("--offset-steps", o.lattice.offsetSteps, "Lattice offsets tried per axis")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 64));
+    app.add_flag("--search-rotation", o.lattice.searchRotation, "Also search the lattice rotation about the up axis");
+    app.add_flag("--check-moves", o.checkEveryMove,
+                 "Debug: after every accepted move verify the frame and compare ΔE with a full recomputation (slow)");
+}
+
+// --- partition (paper §5) -------------------------------------------------------------------------
+
+void PartitionCli::addTo(CLI::App& app) {
+    partition::PartitionOptions& o = options;
+    app.add_option("--salient", salientSpheres,
+                   "Keep the surface within a sphere whole: x,y,z,r in the frame's mm (repeatable)");
+    app.add_option("--salient-faces", salientFacesFile,
+                   "JSON list of salient face indices of the input mesh (or {\"salient_faces\": [...]})");
+    app.add_option("-k,--candidates", o.candidateCount, "Candidate labels per triangle: its k nearest balls")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    app.add_option("--w-smoothness", o.smoothnessStart, "First w_smoothness of the fit schedule")->capture_default_str();
+    app.add_option("--w-smoothness-factor", o.smoothnessFactor,
+                   "Multiply w_smoothness by this while a partition does not fit")
+        ->capture_default_str();
+    app.add_option("--w-smoothness-min", o.smoothnessMin, "The schedule bottoms out below this w_smoothness")
+        ->capture_default_str();
+    app.add_option("--w-saliency", o.saliencyWeight, "w_saliency")->capture_default_str();
+    app.add_option("--min-piece-area-mm2", o.minPieceAreaMm2, "Merge smaller pieces into a neighbour when it fits")
+        ->capture_default_str();
+    app.add_option("--svm-cost", o.svm.cost, "liblinear C for the planar cuts")->capture_default_str();
+    app.add_option("--svm-samples", o.svmMaxSamples, "Train the planar cuts on at most this many faces")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    app.add_flag("--one-vs-rest", isOneVsRest, "One-vs-rest SVMs instead of Crammer-Singer (both give argmax cells)");
+    app.add_option("--graph-nodes", o.graphNodeTarget, "Cluster faces above this many graph-cut nodes (0 = never)")
+        ->capture_default_str();
+}
+
+partition::PartitionOptions PartitionCli::resolve() const {
+    partition::PartitionOptions o = options;
+    for (const std::string& s : salientSpheres) o.salientSpheres.push_back(parseSalientSphere(s));
+    o.svm.useCrammerSinger = !isOneVsRest;
+    return o;
+}
+
+void PartitionCli::resolveSalientFaces(partition::PartitionOptions& o, size_t faceCount) const {
+    if (!salientFacesFile.empty()) o.salientFaceIndices = readSalientFaceList(salientFacesFile, faceCount);
+}
+
+// --- pieces (paper §6) ----------------------------------------------------------------------------
+
+void PiecesCli::addTo(CLI::App& app) {
+    pieces::PiecesOptions& o = options;
+    app.add_option("--min-piece-volume-mm3", o.minPieceVolumeMm3, "Merge smaller pieces into a neighbour")
+        ->capture_default_str();
+    app.add_option("--adaptivity", o.adaptivity, "Meshing: 0 = uniform triangles; up to 1 merges flat regions")
+        ->capture_default_str();
+    app.add_option("--min-tenons", o.tenons.minPerPiece, "Tenons wanted per piece (fewer are reported)")
+        ->capture_default_str();
+    app.add_option("--max-tenons", o.tenons.maxPerPiece, "Most tenons per piece (0 = none)")->capture_default_str();
+    app.add_option("--tenon-clearance-mm", o.tenons.clearanceMm, "Gap between peg and hole on every side")
+        ->capture_default_str();
+    app.add_option("--tenon-width-mm", o.tenons.bodyWidthMm, "Side of the square prism")->capture_default_str();
+    app.add_option("--peg-depth-mm", o.tenons.pegDepthMm, "How far the peg enters the blue hole")->capture_default_str();
+    app.add_option("--tenon-max-length-mm", o.tenons.maxLengthMm, "Longest prism, ball face to inner surface")
+        ->capture_default_str();
+    app.add_option("--tenon-max-tilt-deg", o.tenons.maxTiltDeg, "Largest angle between hole axis and surface normal")
+        ->capture_default_str();
+    app.add_flag("--tenon-lattice-holes-only", o.tenons.latticeHolesOnly,
+                 "Tenons only along the lattice axes (+-x +-y +-z), as the paper; default: all 30 blue holes");
+    app.add_flag("--no-label", isUnlabelled, "Do not engrave piece numbers");
+    app.add_option("--label-height-mm", o.label.heightMm, "Height of the engraved digits")->capture_default_str();
+    app.add_option("--label-depth-mm", o.label.depthMm, "Engraving depth")->capture_default_str();
+}
+
+pieces::PiecesOptions PiecesCli::resolve() const {
+    pieces::PiecesOptions o = options;
+    o.label.isEnabled = !isUnlabelled;
+    pieces::checkPiecesOptions(o);
+    return o;
+}
+
+// --- cost report (paper §7.2) ---------------------------------------------------------------------
+
+void CostCli::addTo(CLI::App& app) {
+    report::CostOptions& cost = options;
+    app.add_option("--slicer", slicer,
+                   "Print times and filament from: estimator (built in) or prusa-slicer (runs it on every part)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"estimator", "prusa-slicer"}));
+    app.add_option("--filament-mm", cost.filament.diameterMm, "Filament diameter")->capture_default_str();
+    app.add_option("--filament-g-per-cm3", cost.filament.densityGPerCm3, "Filament density")->capture_default_str();
+    app.add_option("--filament-usd-per-m", cost.filament.usdPerM, "Filament price per metre")->capture_default_str();
+    app.add_option("--strut-usd", cost.prices.strutUsd, "Price of one Zometool strut")->capture_default_str();
+    app.add_option("--ball-usd", cost.prices.ballUsd, "Price of one Zometool ball")->capture_default_str();
+}
+
+report::CostOptions CostCli::resolve() const {
+    report::CostOptions o = options;
+    if (slicer == "prusa-slicer") o.source = report::EstimateSource::PrusaSlicer;
+    report::checkCostOptions(o);
+    return o;
+}
+
+// --- preview --------------------------------------------------------------------------------------
+
+void PreviewCli::addTo(CLI::App& app) {
+    app.add_flag("--no-draco", isUncompressed, "Store the preview's pieces uncompressed (no KHR_draco_mesh_compression)");
+    app.add_option("--draco-bits", options.glb.dracoPositionBits, "Draco position quantisation, bits")
+        ->capture_default_str()
+        ->check(CLI::Range(8, 30));
+}
+
+report::PreviewOptions PreviewCli::resolve() const {
+    report::PreviewOptions o = options;
+    o.isPieceDracoCompressed = !isUncompressed;
+    return o;
 }
 
 }  // namespace zomefab::cli

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "zomefab/core/transform.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "zomefab/core/error.h"
@@ -61,6 +62,14 @@ void transformInPlace(TriMesh& mesh, const Transform4d& t) {
         Vec3d q = t.apply({p[0], p[1], p[2]});
         p = {float(q[0]), float(q[1]), float(q[2])};
     }
+}
+
+bool isNearlyEqual(const Transform4d& a, const Transform4d& b, double relativeTolerance) {
+    double scale = 1.0;
+    for (double v : a.m) scale = std::max(scale, std::abs(v));
+    for (size_t i = 0; i < 16; ++i)
+        if (std::abs(a.m[i] - b.m[i]) > relativeTolerance * scale) return false;
+    return true;
 }
 
 }  // namespace zomefab

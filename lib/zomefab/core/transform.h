@@ -29,6 +29,10 @@ struct Transform4d {
 /// @throw Error(InvalidInput) when the 3×3 part is singular.
 Transform4d affineInverse(const Transform4d& t);
 
+/// Every entry of @p a within @p relativeTolerance · max(1, largest |entry| of a) of @p b's: the
+/// same transform written out and read back, or computed twice.
+bool isNearlyEqual(const Transform4d& a, const Transform4d& b, double relativeTolerance = 1e-6);
+
 /// Applies @p t to every vertex of @p mesh in place.
 void transformInPlace(TriMesh& mesh, const Transform4d& t);
 

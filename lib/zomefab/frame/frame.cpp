@@ -158,18 +158,30 @@ std::vector<std::string> verifyFrame(const zome::Structure& s, const FrameField&
     return problems;
 }
 
-FrameResult buildFrame(const sdf::InteriorField& field, const FrameOptions& options,
+LatticeOptions latticeOptionsFor(const Fabrication& fabrication, const LatticeOptions& options) {
+    LatticeOptions o = options;
+    o.scale.b0Mm = fabrication.b0Mm;
+    o.zone.dMinMm = fabrication.frameClearanceMm;
+    o.zone.dMaxMm = fabrication.frameReachMm();
+    return o;
+}
+
+FrameResult buildFrame(const sdf::InteriorField& field, const Fabrication& fabrication, const FrameOptions& options,
                        RunContext& context) {
+    checkFabrication(fabrication);
     const Stopwatch total;
     FrameResult r;
     Stopwatch clock;
-    r.lattice = initialLattice(field, options.lattice, context);
+    const LatticeOptions lattice = latticeOptionsFor(fabrication, options.lattice);
+    r.zone = lattice.zone;
+    r.seed = seedFor(fabrication, SeedStream::Frame);
+    r.lattice = initialLattice(field, lattice, context);
     r.latticeSeconds = clock.seconds();
     r.rotationDeg = r.lattice.rotationDeg;
-    const FrameField ff(field, r.rotationDeg, r.lattice.structure.scale(), options.lattice.zone);
+    const FrameField ff(field, r.rotationDeg, r.lattice.structure.scale(), r.zone);
 
     clock = Stopwatch();
-    r.target = estimateTargetCount(r.lattice.structure, ff, options.target, options.seed, context);
+    r.target = estimateTargetCount(r.lattice.structure, ff, options.target, r.seed, context);
     r.targetSeconds = clock.seconds();
     r.energyOptions = options.energy;
     r.energyOptions.targetItemCount = r.target.targetItemCount;
@@ -193,7 +205,7 @@ FrameResult buildFrame(const sdf::InteriorField& field, const FrameOptions& opti
     }
     clock = Stopwatch();
     std::vector<ChainResult> chains = annealChains(r.lattice.structure, ff, r.energyOptions, anneal,
-                                                   options.chains, options.seed, context);
+                                                   options.chains, r.seed, context);
     r.annealSeconds = clock.seconds();
     r.bestChain = bestChain(chains);
     for (const ChainResult& c : chains) {
@@ -230,11 +242,11 @@ nlohmann::json frameReportJson(const FrameResult& r, const FrameOptions& o,
                        {"valence", e.valenceWeight}, {"simplicity", e.simplicityWeight}}},
           {"target_valence", e.targetValence},
           {"valence_on_internal_only", e.valenceOnInternalOnly},
-          {"d_min_mm", o.lattice.zone.dMinMm},
-          {"d_max_mm", o.lattice.zone.dMaxMm},
-          {"f_thick", o.lattice.zone.fThick},
-          {"f_max", o.lattice.zone.fMax},
-          {"b0_mm", o.lattice.scale.b0Mm},
+          {"d_min_mm", r.zone.dMinMm},
+          {"d_max_mm", r.zone.dMaxMm},
+          {"f_thick", r.zone.fThick},
+          {"f_max", r.zone.fMax},
+          {"b0_mm", r.structure.scale().b0Mm},
           {"t_init", a.initialTemperature},
           {"cooling_factor", a.coolingFactor},
           {"cooling_interval", a.coolingIntervalIterations},
@@ -242,7 +254,7 @@ nlohmann::json frameReportJson(const FrameResult& r, const FrameOptions& o,
           {"max_iterations", a.maxIterations},
           {"time_limit_s", a.timeLimitSeconds},
           {"chains", o.chains},
-          {"seed", o.seed}}},
+          {"seed", r.seed}}},
         {"lattice",
          {{"rotation_deg", r.lattice.rotationDeg},
           {"offset_mm", r.lattice.offsetMm},

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "zomefab/core/fabrication.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/core/transform.h"
 #include "zomefab/frame/anneal.h"
@@ -23,14 +24,15 @@
 namespace zomefab::frame {
 
 struct FrameOptions {
-    LatticeOptions lattice;      ///< offset/rotation search, physical sizes, dMin
+    /// Offset/rotation search and the kit's physical sizes. Its scale.b0Mm and zone.dMinMm /
+    /// zone.dMaxMm come from the Fabrication (latticeOptionsFor); what is set here is replaced.
+    LatticeOptions lattice;
     EnergyOptions energy;        ///< weights; targetItemCount is replaced by the τ estimate
     TargetCountOptions target;   ///< how τ is estimated (or fixed)
     AnnealOptions anneal;        ///< cooling schedule and budgets
     /// Independent annealing chains run in parallel; the best is kept. 8: on the demo bunny at 400 mm
     /// the best of 8 has E = 117.5 against 126.4 for one chain, in 0.08 s on 2 cores (32: 116.2).
     int chains = 8;
-    uint64_t seed = 1;           ///< chains and τ runs derive their seeds from it
     double surfaceSampleSpacingMm = 6.0;  ///< surface samples for the gap measure
     /// Debug: after every accepted move, verifyFrame() and a full energy recomputation; the first
     /// violation or a ΔE mismatch beyond 1e-9 relative throws Error(Internal). Slow.
@@ -69,6 +71,8 @@ std::vector<std::string> verifyFrame(const zome::Structure& structure, const Fra
 
 struct FrameResult {
     zome::Structure structure;         ///< the best chain's frame, ids compacted
+    sdf::ForbiddenZoneOptions zone;    ///< the forbidden zone it was built in (from the Fabrication)
+    uint64_t seed = 0;                 ///< seedFor(fabrication, SeedStream::Frame)
     double rotationDeg = 0;            ///< lattice rotation about z
     LatticeResult lattice;             ///< the initial frame and the search statistics
     TargetCountResult target;          ///< τ and the runs it came from
@@ -81,10 +85,14 @@ struct FrameResult {
     double latticeSeconds = 0, targetSeconds = 0, annealSeconds = 0, totalSeconds = 0;
 };
 
+/// @p options' lattice with the Fabrication's b0 (the kit's scale) and forbidden zone (d_min =
+/// frameClearanceMm, d_max = b0): the one place the frame stage takes them from.
+LatticeOptions latticeOptionsFor(const Fabrication& fabrication, const LatticeOptions& options);
+
 /// The frame stage. @p field is the object's "interior" field in mm (z up).
 /// @throw Error(ProcessingFailed) when the object is too thin for one cube; Error(Usage) for
 ///        invalid options; Error(Cancelled).
-FrameResult buildFrame(const sdf::InteriorField& field, const FrameOptions& options,
+FrameResult buildFrame(const sdf::InteriorField& field, const Fabrication& fabrication, const FrameOptions& options,
                        RunContext& context);
 
 /// transform_mm of the frame file: the field's transform_mm (input mesh → field mm) followed by

@@ -14,6 +14,7 @@
 
 #include "zomefab/core/disjoint_sets.h"
 #include "zomefab/core/error.h"
+#include "zomefab/core/fabrication.h"
 #include "zomefab/core/format.h"
 #include "zomefab/core/vec.h"
 #include "zomefab/partition/alpha_expansion.h"
@@ -220,16 +221,11 @@ void groupFaces(const std::vector<uint32_t>& idOf, uint32_t idCount, std::vector
     for (uint32_t f = 0; f < idOf.size(); ++f) faces[fill[idOf[f]]++] = f;
 }
 
-/// Quick accept: an axis-aligned box or a bounding sphere that fits needs no orientation search.
+/// Quick accept: an axis-aligned box that fits needs no orientation search.
 bool fitsTrivially(const std::vector<Vec3d>& pts, const Vec3d& printer, double margin) {
     Box3d box;
     for (const Vec3d& p : pts) box.expand(p);
-    Vec3d e = box.size();
-    for (double& x : e) x += 2 * margin;
-    std::sort(e.begin(), e.end());
-    Vec3d p = printer;
-    std::sort(p.begin(), p.end());
-    return e[0] <= p[0] && e[1] <= p[1] && e[2] <= p[2];
+    return boxFitsPrinter(box.size(), printer, margin);
 }
 
 /// The schedule's fit test (docs/partition.md §4): the quick accept, else the oriented-box search.
@@ -240,14 +236,14 @@ bool fitsPrinter(const std::vector<Vec3d>& pts, const Vec3d& printer, double mar
 struct Context {
     const TriMesh& mesh;
     const FaceGraph& graph;
-    const PartitionOptions& opt;
+    const Fabrication& fab;
     const RunContext& run;
     std::vector<uint32_t> stamp;
     uint32_t stampValue = 0;
 
     PrinterFit fitOf(const std::vector<uint32_t>& faces) {
         const std::vector<Vec3d> pts = faceVertices(mesh, faces, stamp, stampValue);
-        return fitInPrinter(pts, opt.printerMm, opt.fitMarginMm);
+        return fitInPrinter(pts, fab.printerMm, fab.fitMarginMm);
     }
 };
 
@@ -259,7 +255,7 @@ std::vector<char> fitsEach(Context& cx, const std::vector<std::vector<uint32_t>>
     std::vector<std::vector<Vec3d>> pts(n);
     for (size_t c = 0; c < n; ++c) pts[c] = faceVertices(cx.mesh, faceSets[c], cx.stamp, cx.stampValue);
     std::vector<char> fits(n, 1);
-    tbb::parallel_for(size_t(0), n, [&](size_t c) { fits[c] = fitsPrinter(pts[c], cx.opt.printerMm, cx.opt.fitMarginMm); });
+    tbb::parallel_for(size_t(0), n, [&](size_t c) { fits[c] = fitsPrinter(pts[c], cx.fab.printerMm, cx.fab.fitMarginMm); });
     return fits;
 }
 
@@ -315,22 +311,20 @@ double sharedEdgeMm(const TriMesh& mesh, uint32_t f, uint32_t h) {
 
 // --- public helpers ---------------------------------------------------------------------------
 
-void checkPartitionOptions(const PartitionOptions& o, const zome::ZomeScale& scale) {
+void checkPartitionOptions(const PartitionOptions& o, const Fabrication& fab, const zome::ZomeScale& scale) {
     auto usage = [](const std::string& m) { throw Error(ErrorCode::Usage, m); };
-    for (double p : o.printerMm)
-        if (!(p > 0.0) || !std::isfinite(p)) usage("printer size " + sizeText(o.printerMm) + ": every side must be > 0");
-    const double minSide = std::min({o.printerMm[0], o.printerMm[1], o.printerMm[2]});
-    if (minSide < scale.ballDiameterMm + 2.0 * o.fitMarginMm)
-        usage("printer volume " + sizeText(o.printerMm) + " is smaller than a Zome ball (" +
+    checkFabrication(fab);
+    const double minSide = std::min({fab.printerMm[0], fab.printerMm[1], fab.printerMm[2]});
+    if (minSide < scale.ballDiameterMm + 2.0 * fab.fitMarginMm)
+        usage("printer volume " + sizeText(fab.printerMm) + " is smaller than a Zome ball (" +
               formatNumbers("%.1f mm across", scale.ballDiameterMm) +
-              (o.fitMarginMm > 0 ? formatNumbers(" plus 2 x %.1f mm margin", o.fitMarginMm) : std::string()) + ")");
+              (fab.fitMarginMm > 0 ? formatNumbers(" plus 2 x %.1f mm margin", fab.fitMarginMm) : std::string()) + ")");
     if (o.candidateCount < 1) usage("k (candidate labels per triangle) must be >= 1");
     if (!(o.dataWeight > 0.0) || !std::isfinite(o.dataWeight)) usage("w_data must be > 0");
     if (!(o.saliencyWeight >= 0.0) || !std::isfinite(o.saliencyWeight)) usage("w_saliency must be >= 0");
     if (!(o.smoothnessStart >= 0.0) || !std::isfinite(o.smoothnessStart)) usage("w_smoothness must be >= 0");
     if (!(o.smoothnessFactor > 0.0 && o.smoothnessFactor < 1.0)) usage("the w_smoothness factor must be in (0, 1)");
     if (!(o.smoothnessMin >= 0.0)) usage("the smallest w_smoothness must be >= 0");
-    if (!(o.fitMarginMm >= 0.0) || !std::isfinite(o.fitMarginMm)) usage("the fit margin must be >= 0 mm");
     if (!(o.minDistanceB0 > 0.0)) usage("the distance clamp must be > 0");
     if (!(o.minDihedralRad > 0.0 && o.minDihedralRad < kPi)) usage("the dihedral clamp must be in (0, pi)");
     if (!(o.svm.cost > 0.0) || !(o.svm.tolerance > 0.0)) usage("SVM cost and tolerance must be > 0");
@@ -484,8 +478,8 @@ namespace {
 class Stage {
 public:
     Stage(const TriMesh& meshMm, const zome::Structure& frame, const std::vector<zome::BallId>& labelBalls,
-          const PartitionOptions& opt, const RunContext& run)
-        : mMesh(meshMm), mFrame(frame), mLabelBalls(labelBalls), mOpt(opt), mRun(run),
+          const Fabrication& fab, const PartitionOptions& opt, const RunContext& run)
+        : mMesh(meshMm), mFrame(frame), mLabelBalls(labelBalls), mFab(fab), mOpt(opt), mRun(run),
           mFaceCount(meshMm.triangles.size()), mLabelCount(uint32_t(labelBalls.size())),
           mB0(frame.scale().b0Mm) {}
 
@@ -508,7 +502,7 @@ private:
     // --- inputs ---------------------------------------------------------------------------------
 
     void checkInputs() {
-        checkPartitionOptions(mOpt, mFrame.scale());
+        checkPartitionOptions(mOpt, mFab, mFrame.scale());
         if (mMesh.triangles.empty()) throw Error(ErrorCode::InvalidInput, "the mesh has no triangles");
         if (mLabelBalls.empty())
             throw Error(ErrorCode::InvalidInput,
@@ -523,8 +517,8 @@ private:
                 throw Error(ErrorCode::InvalidInput, "label ball " + std::to_string(sorted[i]) + " is listed twice");
         }
         mRes.b0Mm = mB0;
-        mRes.printerMm = mOpt.printerMm;
-        mRes.fitMarginMm = mOpt.fitMarginMm;
+        mRes.printerMm = mFab.printerMm;
+        mRes.fitMarginMm = mFab.fitMarginMm;
         mRes.labelBalls = mLabelBalls;
 
         // Mesh/frame mismatch: the frame sits inside the shell, so every label ball lies inside the
@@ -982,7 +976,7 @@ private:
         std::vector<uint32_t> regionOf;
         const uint32_t regionCount = labelComponents(mGraph, mTrainClass, regionOf);
         const RegionMerge m =
-            mergeRegionsThatFit(mMesh, mGraph, regionOf, regionCount, mOpt.printerMm, mOpt.fitMarginMm);
+            mergeRegionsThatFit(mMesh, mGraph, regionOf, regionCount, mFab.printerMm, mFab.fitMarginMm);
         mFaceGroup.resize(mFaceCount);
         for (uint32_t f = 0; f < mFaceCount; ++f) mFaceGroup[f] = m.groupOf[regionOf[f]];
         mGroupCount = m.groupCount;
@@ -995,7 +989,7 @@ private:
     Context& context() {
         if (!mContext)
             mContext = std::make_unique<Context>(
-                Context{mMesh, mGraph, mOpt, mRun, std::vector<uint32_t>(mMesh.positions.size(), 0), 0});
+                Context{mMesh, mGraph, mFab, mRun, std::vector<uint32_t>(mMesh.positions.size(), 0), 0});
         return *mContext;
     }
 
@@ -1081,7 +1075,7 @@ private:
         std::vector<uint32_t> classes;
         trainingSamples(samples, classes);
         CellTrainingOptions so = mOpt.svm;
-        so.seed = mOpt.seed;
+        so.seed = seedFor(mFab, SeedStream::Partition);
         LinearCells cells = trainLinearCells(samples, classes, so);
         crossed = crossedRegions(cells);
         for (int retry = 0; retry < mOpt.salientRetries && !crossed.empty(); ++retry) {
@@ -1249,7 +1243,7 @@ private:
             for (const Vec3d& v : piecePts[p]) piece.boundsMm.expand(v);
         }
         tbb::parallel_for(uint32_t(0), pieceCount, [&](uint32_t p) {
-            pieces[p].fit = fitInPrinter(piecePts[p], mOpt.printerMm, mOpt.fitMarginMm);
+            pieces[p].fit = fitInPrinter(piecePts[p], mFab.printerMm, mFab.fitMarginMm);
         });
         return pieces;
     }
@@ -1295,7 +1289,7 @@ private:
             if (!tooLarge.empty() && round >= mOpt.maxRepairRounds)
                 throw Error(ErrorCode::ProcessingFailed,
                             std::to_string(tooLarge.size()) + " piece(s) still do not fit the printer " +
-                                sizeText(mOpt.printerMm) + " after " + std::to_string(round) + " repair rounds (piece " +
+                                sizeText(mFab.printerMm) + " after " + std::to_string(round) + " repair rounds (piece " +
                                 std::to_string(tooLarge.front()) + " needs " +
                                 sizeText(pieces[tooLarge.front()].fit.extentsMm) + ")");
             if (tooLarge.empty()) {
@@ -1334,6 +1328,7 @@ private:
     const TriMesh& mMesh;
     const zome::Structure& mFrame;
     const std::vector<zome::BallId>& mLabelBalls;
+    const Fabrication& mFab;
     const PartitionOptions& mOpt;
     const RunContext& mRun;
     const size_t mFaceCount;
@@ -1363,9 +1358,9 @@ private:
 }  // namespace
 
 PartitionResult partitionSurface(const TriMesh& meshMm, const zome::Structure& frame,
-                                 const std::vector<zome::BallId>& labelBalls, const PartitionOptions& options,
-                                 const RunContext& context) {
-    return Stage(meshMm, frame, labelBalls, options, context).run();
+                                 const std::vector<zome::BallId>& labelBalls, const Fabrication& fabrication,
+                                 const PartitionOptions& options, const RunContext& context) {
+    return Stage(meshMm, frame, labelBalls, fabrication, options, context).run();
 }
 
 }  // namespace zomefab::partition

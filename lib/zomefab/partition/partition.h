@@ -16,10 +16,12 @@
 #include <cstdint>
 #include <vector>
 
+#include "zomefab/core/fabrication.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/core/tri_mesh.h"
 #include "zomefab/partition/face_graph.h"
 #include "zomefab/partition/linear_cells.h"
+#include "zomefab/partition/partition_result.h"
 #include "zomefab/partition/printer_fit.h"
 #include "zomefab/zome/structure.h"
 
@@ -55,10 +57,6 @@ struct PartitionOptions {
     /// turn the whole surface into small pieces. false: every step cuts the whole surface again
     /// (the paper's schedule).
     bool refineOversizedOnly = true;
-    Vec3d printerMm{200.0, 200.0, 200.0};  ///< build volume, mm (about the paper's Ultimaker 3)
-    /// Every side of a piece's oriented box is grown by this much before the fit test, for the
-    /// shell's thickness behind the surface and the connectors (mm).
-    double fitMarginMm = 2.0;
     int maxSweeps = 100;  ///< alpha-expansion passes per graph cut at most
     /// true (default): after the schedule, a region is merged into a neighbour (sharing a seam)
     /// whenever the union still fits the printer (same oriented-box test and margin), smallest
@@ -73,7 +71,7 @@ struct PartitionOptions {
     std::vector<uint32_t> salientFaceIndices;   ///< faces marked by index
 
     // --- planar cuts (§5.2) -------------------------------------------------------------------
-    CellTrainingOptions svm;  ///< seed is taken from @c seed below
+    CellTrainingOptions svm;  ///< its seed is seedFor(fabrication, SeedStream::Partition)
     /// Training samples at most: above it, up to half go to faces within two rings of a class
     /// boundary and the rest to the other faces, each thinned evenly in face order (deterministic),
     /// which keeps training time flat on large meshes.
@@ -96,93 +94,23 @@ struct PartitionOptions {
     /// The nodes of the refinement (and of a one-level cut): faces, or above this many faces about
     /// this many small clusters, so the graph-cut cost stays flat on very fine meshes. 0 = faces.
     size_t refineNodeTarget = 2000000;
-
-    uint64_t seed = 1;  ///< for liblinear's shuffling
-};
-
-/// One step of the fit schedule.
-struct ScheduleStep {
-    double smoothnessWeight = 0.0;
-    /// E (face level, whole surface) at this weight of the starting labelling: the nearest ball on
-    /// the faces this step cuts, the kept regions as they are.
-    double energyNearest = 0.0;
-    double energyGraphCut = 0.0;  ///< E after alpha-expansion
-    size_t partitions = 0;        ///< connected label regions of the whole surface after this step
-    size_t oversized = 0;         ///< regions that do not fit the printer
-    size_t faces = 0;             ///< faces this step cut: all at a whole-surface cut, else those of
-                                  ///< the regions that did not fit at the step before
-    size_t kept = 0;              ///< regions this step kept (they fit; later steps leave them alone)
-    int sweeps = 0;               ///< node-level passes (the band refinement with two levels)
-    int expansions = 0;           ///< node-level max-flow solves
-    // With two levels (graphNodeTarget): the cluster-level cut and the refinement band.
-    int clusterSweeps = 0;
-    int clusterExpansions = 0;
-    double energyClusters = 0.0;  ///< E of the cluster-level result
-    size_t bandNodes = 0;         ///< nodes free in the refinement
-    double seconds = 0.0;
-};
-
-/// A physical piece: connected surface faces, one or more cells, fitting the printer.
-struct Piece {
-    std::vector<uint32_t> cells;      ///< the cells it is made of (several after a merge)
-    std::vector<zome::BallId> balls;  ///< the label balls of those cells
-    uint32_t faceCount = 0;
-    double areaMm2 = 0.0;
-    Box3d boundsMm;                   ///< axis-aligned box of its faces' vertices
-    PrinterFit fit;                   ///< best orientation in the printer
-};
-
-struct PartitionResult {
-    double b0Mm = 47.3;
-    Vec3d printerMm{200, 200, 200};
-    double fitMarginMm = 0.0;
-    std::vector<zome::BallId> labelBalls;   ///< label index → ball id (the input N_out order)
-    std::vector<uint32_t> nearestLabels;    ///< per face: label of the nearest ball
-    std::vector<uint32_t> graphCutLabels;   ///< per face: label after the fit schedule (each region as
-                                            ///< the step that kept it cut it)
-    LinearCells cells;                      ///< argmax cells in mm
-    std::vector<zome::BallId> cellBalls;    ///< cell → the ball it attaches to
-    std::vector<uint32_t> faceCells;        ///< per face: the cell containing its centroid
-    std::vector<uint32_t> facePieces;       ///< per face: its piece
-    std::vector<Piece> pieces;
-    std::vector<uint8_t> salientFaces;      ///< per face (after spheres and indices)
-    size_t salientRegions = 0;              ///< edge-connected salient regions
-    size_t salientRegionsSplit = 0;         ///< regions a final seam still crosses (0 normally)
-
-    std::vector<ScheduleStep> schedule;
-    double smoothnessWeight = 0.0;          ///< w_smoothness of the last schedule step
-    double energyNearest = 0.0;             ///< the last step's ScheduleStep::energyNearest
-    double energyGraphCut = 0.0;            ///< the last step's ScheduleStep::energyGraphCut
-    std::vector<double> sweepEnergies;      ///< of the last step's graph cut
-    size_t nearestPartitions = 0;           ///< connected regions of the nearest-ball labelling
-    size_t graphCutPartitions = 0;          ///< connected regions of graphCutLabels (before splits)
-    bool isScheduleBottomedOut = false;     ///< the schedule ended without every partition fitting
-    size_t splits = 0;                      ///< partitions/pieces split to fit the printer
-    size_t merges = 0;                      ///< small pieces merged into a neighbour
-    size_t regionMerges = 0;                ///< regions merged after the schedule (mergeSmallRegions)
-    size_t svmSamples = 0;                  ///< training samples used
-    double svmAgreement = 0.0;              ///< fraction of faces whose cell matches its region
-    size_t graphNodes = 0;                  ///< nodes of the first graph cut (faces or clusters;
-                                            ///< a salient region is one node)
-    size_t refineNodes = 0;                 ///< nodes of the refinement level (faces or small clusters)
-    size_t candidatePairs = 0;              ///< Σ candidates over those nodes: "triangles × labels"
-    double secondsGraphCut = 0.0;
-    double secondsSvm = 0.0;
-    double secondsTotal = 0.0;
 };
 
 /// Partitions the outer surface @p meshMm (mm, in the frame's coordinates) with the balls
-/// @p labelBalls of @p frame as labels.
+/// @p labelBalls of @p frame as labels, into pieces that fit the Fabrication's printer (with its
+/// fit margin).
 /// @throw Error(InvalidInput) for an empty mesh, no label balls, a label that is not a ball of
 ///   the frame, or a frame that does not sit inside the mesh (mesh/frame mismatch);
 ///   Error(Usage) for bad options (printer smaller than a ball, k < 1, bad weights, a salient face
 ///   index out of range); Error(Cancelled).
 PartitionResult partitionSurface(const TriMesh& meshMm, const zome::Structure& frame,
-                                 const std::vector<zome::BallId>& labelBalls, const PartitionOptions& options,
-                                 const RunContext& context);
+                                 const std::vector<zome::BallId>& labelBalls, const Fabrication& fabrication,
+                                 const PartitionOptions& options, const RunContext& context);
 
-/// Checks @p options on their own (before any input is read). @throw Error(Usage)
-void checkPartitionOptions(const PartitionOptions& options, const zome::ZomeScale& scale = {});
+/// Checks @p options on their own (before any input is read), and that the Fabrication's printer
+/// holds a ball of @p scale with the fit margin on every side. @throw Error(Usage)
+void checkPartitionOptions(const PartitionOptions& options, const Fabrication& fabrication,
+                           const zome::ZomeScale& scale = {});
 
 /// The greedy region merge of PartitionOptions::mergeSmallRegions (docs/partition.md §4).
 struct RegionMerge {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "zomefab/partition/partition_json.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -109,6 +110,31 @@ json partitionToJson(const PartitionResult& r, const PartitionOptions& o, const 
     j["face_cells"] = r.faceCells;
     j["face_pieces"] = r.facePieces;
     return j;
+}
+
+json partitionSummaryJson(const PartitionResult& r) {
+    double worst = 0.0;
+    for (const Piece& p : r.pieces) worst = std::max(worst, p.fit.ratio);
+    return {{"faces", r.faceCells.size()},
+            {"labels", r.labelBalls.size()},
+            {"graph_nodes", r.graphNodes},
+            {"candidate_pairs", r.candidatePairs},
+            {"w_smoothness", r.smoothnessWeight},
+            {"energy_nearest_ball", r.energyNearest},
+            {"energy_graph_cut", r.energyGraphCut},
+            {"nearest_ball_partitions", r.nearestPartitions},
+            {"graph_cut_partitions", r.graphCutPartitions},
+            {"pieces", r.pieces.size()},
+            {"largest_fit_ratio", worst},
+            {"seconds", {{"graph_cut", r.secondsGraphCut}, {"svm_and_pieces", r.secondsSvm}, {"total", r.secondsTotal}}}};
+}
+
+const std::vector<uint32_t>& faceGroups(const PartitionResult& r, const std::string& groups) {
+    if (groups == "pieces") return r.facePieces;
+    if (groups == "cells") return r.faceCells;
+    if (groups == "labels") return r.graphCutLabels;
+    if (groups == "nearest") return r.nearestLabels;
+    throw Error(ErrorCode::Usage, "face groups must be pieces, cells, labels or nearest, got \"" + groups + "\"");
 }
 
 std::string coloredPlyBytes(const TriMesh& mesh, const std::vector<uint32_t>& groups) {

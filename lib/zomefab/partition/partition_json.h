@@ -24,9 +24,30 @@ struct PartitionJsonInfo {
     size_t vertexCount = 0;
 };
 
-/// The PARTITION.json document. Contains no timings, so equal inputs give equal bytes.
+/// The PARTITION.json document. Contains no timings, so equal inputs give equal bytes; every
+/// writer dumps it with an indent of 1 and a final newline.
 nlohmann::json partitionToJson(const PartitionResult& result, const PartitionOptions& options,
                                const PartitionJsonInfo& info);
+
+/// The headline numbers of a result (zf-partition's --report): faces, labels, graph sizes,
+/// energies, partitions, pieces, the largest fit ratio and the timings.
+nlohmann::json partitionSummaryJson(const PartitionResult& result);
+
+/// The per-face groups to colour a mesh by: "pieces", "cells", "labels" (after the graph cut) or
+/// "nearest" (the nearest-ball labelling). @throw Error(Usage) for another name.
+const std::vector<uint32_t>& faceGroups(const PartitionResult& result, const std::string& groups);
+
+/// A partition file read back: the result (what the pieces stage needs and the numbers reports
+/// show; the per-face arrays when present) and the record of where it came from.
+struct PartitionFile {
+    PartitionResult result;
+    PartitionJsonInfo info;
+};
+
+/// The inverse of partitionToJson. Checks the format and version, that every cell and piece is
+/// complete, every index in range (cells of pieces, balls of cells) and every number finite.
+/// @throw Error(InvalidInput) naming the field (callers add the file).
+PartitionFile partitionFromJson(const nlohmann::json& document);
 
 /// Binary little-endian PLY of @p meshMm with `uchar red, green, blue` and `int group` per face:
 /// @p faceGroups (piece, cell or label ids) coloured by a golden-ratio hue walk, so neighbouring

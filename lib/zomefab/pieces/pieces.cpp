@@ -68,7 +68,7 @@ struct GridCells {
     }
 };
 
-GridCells toGridCells(const CellModel& model, const Transform4d& frameToGrid) {
+GridCells toGridCells(const partition::LinearCells& model, const Transform4d& frameToGrid) {
     // s(x_f) = w·x_f + b with x_f = Rᵀ(x_g − t): w' = R·w, b' = b − w'·t.
     GridCells c;
     const Vec3d t{frameToGrid.at(0, 3), frameToGrid.at(1, 3), frameToGrid.at(2, 3)};
@@ -303,9 +303,6 @@ void checkRigid(const Transform4d& t) {
 void checkPiecesOptions(const PiecesOptions& o) {
     if (!(o.minPieceVolumeMm3 >= 0 && std::isfinite(o.minPieceVolumeMm3)))
         throw Error(ErrorCode::Usage, "the smallest piece volume must be a finite number ≥ 0 mm³");
-    for (double p : o.printerMm)
-        if (!(p >= 10.0 && p <= 10000.0))
-            throw Error(ErrorCode::Usage, "printer sizes must be in [10, 10000] mm, got " + formatNumber(p, 4));
     if (!(o.adaptivity >= 0 && o.adaptivity <= 1))
         throw Error(ErrorCode::Usage, "adaptivity must be in [0, 1], got " + formatNumber(o.adaptivity, 4));
     checkTenonOptions(o.tenons);
@@ -313,10 +310,13 @@ void checkPiecesOptions(const PiecesOptions& o) {
 }
 
 Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, const Transform4d& frameToGridMm,
-                  const CellModel& model, const std::vector<PieceRequest>& requests, const PiecesOptions& options,
-                  RunContext& context) {
+                  const partition::PartitionResult& partition, const Fabrication& fabrication,
+                  const PiecesOptions& options, RunContext& context) {
     Stopwatch clock;
+    checkFabrication(fabrication);
     checkPiecesOptions(options);
+    const partition::LinearCells& model = partition.cells;
+    const std::vector<partition::Piece>& requests = partition.pieces;
     checkRigid(frameToGridMm);
     if (model.w.empty() || model.w.size() != model.b.size())
         throw Error(ErrorCode::InvalidInput, "the cell model needs as many offsets b as normals w, and at least one cell");
@@ -345,7 +345,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
 
     Pieces out;
     out.options = opt;
-    out.printerMm = opt.printerMm;
+    out.printerMm = fabrication.printerMm;
     out.voxelMm = voxel;
     out.frameToGridMm = frameToGridMm;
     out.gridTransformMm = shellSet.info().transformMm;
@@ -852,14 +852,14 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame, c
                     planes.push_back({scale(sub(cells.w[j], cells.w[k]), inv), (cells.b[j] - cells.b[k]) * inv, 0.0});
                 }
             const std::vector<CutFace> faces = measureCutFaces(mesh, planes, 0.05 * voxel);
-            const PrintOrientation orientation = orientForPrinter(mesh, faces, opt.printerMm);
+            const PrintOrientation orientation = orientForPrinter(mesh, faces, fabrication.printerMm);
             orientationNotes[p] = orientation.note;
             if (!orientation.fits) {
                 const Vec3d e = orientation.extentsMm;
                 throw Error(ErrorCode::ProcessingFailed,
                             "piece " + std::to_string(p) + " (" + formatNumber(e[0], 4) + " × " + formatNumber(e[1], 4) + " × " +
-                                formatNumber(e[2], 4) + " mm at best) fits the " + formatNumber(opt.printerMm[0], 4) + " × " +
-                                formatNumber(opt.printerMm[1], 4) + " × " + formatNumber(opt.printerMm[2], 4) +
+                                formatNumber(e[2], 4) + " mm at best) fits the " + formatNumber(fabrication.printerMm[0], 4) + " × " +
+                                formatNumber(fabrication.printerMm[1], 4) + " × " + formatNumber(fabrication.printerMm[2], 4) +
                                 " mm printer in no orientation: the partition must cut it smaller (zf-partition "
                                 "--printer-mm, --fit-margin-mm)");
             }

@@ -6,7 +6,7 @@
 ///
 /// @code
 ///   const Transform4d frameToGrid = shell.info().transformMm * affineInverse(frameTransformMm);
-///   Pieces p = makePieces(shell, frame, frameToGrid, cells, requests, options, context);
+///   Pieces p = makePieces(shell, frame, frameToGrid, partitionResult, fabrication, options, context);
 ///   writePieces(p, "out/pieces", {"shell.vdb", "frame.json", "partition.json"});
 /// @endcode
 #pragma once
@@ -17,32 +17,17 @@
 #include <string>
 #include <vector>
 
+#include "zomefab/core/fabrication.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/core/transform.h"
 #include "zomefab/core/tri_mesh.h"
+#include "zomefab/partition/partition_result.h"
 #include "zomefab/pieces/label.h"
 #include "zomefab/pieces/tenons.h"
 #include "zomefab/sdf/level_set.h"
 #include "zomefab/zome/structure.h"
 
 namespace zomefab::pieces {
-
-/// The partition's cells (paper §5.2) in the frame's millimetres: cell k = {x : w_k·x + b_k is
-/// largest}, ties to the lowest k. Argmax cells are convex and cover space without gaps or
-/// overlaps; the face between cells k and j lies on the plane (w_k − w_j)·x + (b_k − b_j) = 0.
-struct CellModel {
-    std::vector<Vec3d> w;   ///< per cell, 1/mm
-    std::vector<double> b;  ///< per cell, dimensionless
-    size_t cellCount() const { return w.size(); }
-};
-
-/// One piece the partition asks for: the cells it is cut from (several after the partition merged
-/// small pieces) and the box of its outer surface, which tells apart the pieces that share a cell
-/// (a cell whose surface falls apart into separate patches).
-struct PieceRequest {
-    std::vector<uint32_t> cells;
-    Box3d boundsMm;  ///< frame mm; empty = unknown
-};
 
 struct PiecesOptions {
     /// Connected pieces with less volume are merged into the neighbour they share the largest cut
@@ -51,8 +36,6 @@ struct PiecesOptions {
     double minPieceVolumeMm3 = 2000.0;
     TenonOptions tenons;
     LabelOptions label;
-    /// Build volume of the printer (paper: Ultimaker 3, 200 mm cube), any order of the sides.
-    Vec3d printerMm{200.0, 200.0, 200.0};
     /// volumeToMesh adaptivity: 0 = one vertex per surface voxel; larger merges flat regions into
     /// larger triangles (tenons and numbers stay at full resolution). 0.3 gives the bunny at 400 mm
     /// 24 MB of STL where 0 gives 121 MB (docs/pieces.md).
@@ -66,7 +49,7 @@ void checkPiecesOptions(const PiecesOptions& options);
 struct Piece {
     uint32_t id = 0;
     std::vector<uint32_t> cells;      ///< cells it is cut from (sorted)
-    std::vector<uint32_t> requests;   ///< PieceRequest indices it comes from (sorted)
+    std::vector<uint32_t> requests;   ///< the partition's pieces it comes from (sorted)
     /// Pieces sharing a cut face, with the face's area (mm², first order in the voxel).
     std::vector<std::pair<uint32_t, double>> neighbors;
     uint32_t sliversMerged = 0;       ///< small components merged into this piece
@@ -98,7 +81,7 @@ struct Piece {
 /// The result of makePieces.
 struct Pieces {
     std::vector<Piece> pieces;
-    Vec3d printerMm{200, 200, 200};
+    Vec3d printerMm = Fabrication{}.printerMm;  ///< the Fabrication's printer they were oriented for
     double voxelMm = 0.0;
     double shellVolumeMm3 = 0.0;        ///< the shell, counted in voxels
     /// Shell volume in cells no request names (no outer surface there): merged into neighbours.
@@ -111,21 +94,22 @@ struct Pieces {
     double seconds = 0.0;
 };
 
-/// Cuts @p shell into printable pieces (paper §6).
+/// Cuts @p shell into printable pieces (paper §6) that fit the Fabrication's printer.
 /// @param shell         the hollow shell level set (zf-shell), grid mm
 /// @param frame         the Zometool frame, frame mm
 /// @param frameToGridMm frame mm → grid mm: T_grid · T_frame⁻¹ of the two transform_mm; must be a
 ///                      rotation plus a translation (the two were scaled alike)
-/// @param cells         the partition's cells, frame mm
-/// @param requests      the partition's pieces; the shell in cells no request names joins the
-///                      neighbouring pieces
+/// @param partition     the partition stage's result as it is: its argmax cells (frame mm) and
+///                      its pieces (their cells and surface boxes); the shell in cells no piece
+///                      names joins the neighbouring pieces. A piece's bounds tell apart the
+///                      pieces that share a cell (a cell whose surface falls into separate patches).
 /// @throw Error(Usage) for bad options or a voxel too coarse for the tenon pegs;
 ///        Error(InvalidInput) for an empty shell, a request naming an unknown cell, mismatched
 ///        cell arrays, or a frameToGridMm that scales; Error(ProcessingFailed) when a piece fits
 ///        the printer in no orientation (the partition must cut smaller), or a piece mesh is not
 ///        closed; Error(Cancelled).
 Pieces makePieces(const sdf::LevelSet& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
-                  const CellModel& cells, const std::vector<PieceRequest>& requests, const PiecesOptions& options,
-                  RunContext& context);
+                  const partition::PartitionResult& partition, const Fabrication& fabrication,
+                  const PiecesOptions& options, RunContext& context);
 
 }  // namespace zomefab::pieces

@@ -139,22 +139,30 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
     return j;
 }
 
-void writePieces(const Pieces& all, const std::string& directory, const PiecesJsonInfo& info) {
-    StagedDirectory staging(directory, "pieces.json");
+void writePiecesThreeMf(const Pieces& all, const std::string& path) {
     std::vector<ThreeMfObject> objects;
     // The 3MF lays the pieces out on a plate of bed-sized cells, 10 mm apart, row by row.
     const size_t columns = size_t(std::ceil(std::sqrt(double(std::max<size_t>(all.pieces.size(), 1)))));
     for (size_t i = 0; i < all.pieces.size(); ++i) {
-        writeMesh(all.pieces[i].mesh, staging.file(pieceFileName(all, i)));
         const double dx = double(i % columns) * (all.printerMm[0] + 10.0);
         const double dy = double(i / columns) * (all.printerMm[1] + 10.0);
-        objects.push_back({pieceName(all, i), &all.pieces[i].mesh,
-                           Transform4d::scaleTranslate(1.0, {dx, dy, 0.0})});
+        objects.push_back({pieceName(all, i), &all.pieces[i].mesh, Transform4d::scaleTranslate(1.0, {dx, dy, 0.0})});
     }
-    writeThreeMf(objects, generatorString(), staging.file("pieces.3mf"));
+    writeThreeMf(objects, generatorString(), path);
+}
+
+void writePieceFiles(const Pieces& all, const std::string& directory, const PiecesJsonInfo& info) {
+    for (size_t i = 0; i < all.pieces.size(); ++i)
+        writeMesh(all.pieces[i].mesh, directory + "/" + pieceFileName(all, i));
     const std::string text = piecesToJson(all, info).dump(2) + "\n";
-    writeOutputAtomic(staging.file("pieces.json"),
+    writeOutputAtomic(directory + "/" + kPiecesFile,
                       [&](std::ostream& out) { out.write(text.data(), std::streamsize(text.size())); });
+}
+
+void writePieces(const Pieces& all, const std::string& directory, const PiecesJsonInfo& info) {
+    StagedDirectory staging(directory, kPiecesFile);
+    writePieceFiles(all, staging.path(), info);
+    writePiecesThreeMf(all, staging.file("pieces.3mf"));
     staging.commit();
 }
 

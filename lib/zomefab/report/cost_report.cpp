@@ -33,7 +33,7 @@ nlohmann::json printJson(const PrintEstimate& e) {
     return j;
 }
 
-nlohmann::json fabricationJson(const Fabrication& f) {
+nlohmann::json makingCostJson(const MakingCost& f) {
     return {
         {"print", printJson(f.print)},
         {"filament",
@@ -66,26 +66,31 @@ void checkCostOptions(const CostOptions& options) {
                                           ": not installed or not executable (Debian package prusa-slicer)");
 }
 
-CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piecesMm,
-                      const zome::PartsList& parts, const CostOptions& options, RunContext& context) {
+CostReport costReport(const TriMesh& objectMm, const std::vector<const TriMesh*>& piecesMm,
+                      const zome::PartsList& parts, const Fabrication& fabrication, const CostOptions& options,
+                      RunContext& context) {
+    checkFabrication(fabrication);
     checkCostOptions(options);
     CostReport report;
+    report.printerMm = fabrication.printerMm;
     report.options = options;
     report.source = options.source;
     report.parts = parts;
     report.pieceCount = piecesMm.size();
     report.objectVolumeMm3 = signedVolume(objectMm);
-    for (const TriMesh& p : piecesMm) report.piecesVolumeMm3 += signedVolume(p);
+    for (const TriMesh* p : piecesMm) report.piecesVolumeMm3 += signedVolume(*p);
 
     context.progress("report", 0.0);
-    const std::vector<TriMesh> baselineParts = octreeParts(objectMm, options.printerMm, 10, context);
+    const std::vector<TriMesh> baselineParts = octreeParts(objectMm, fabrication.printerMm, 10, context);
     report.baselinePartCount = baselineParts.size();
 
     const double zomeUsd = zome::partsCostUsd(parts, options.prices);
     const double buildHours = assemblyHours(parts, options.assembly);
     const size_t total = 2 * (piecesMm.size() + baselineParts.size());
     size_t done = 0;
-    auto printAll = [&](const std::vector<TriMesh>& meshes, const PrintSettings& settings,
+    std::vector<const TriMesh*> baselinePointers;
+    for (const TriMesh& part : baselineParts) baselinePointers.push_back(&part);
+    auto printAll = [&](const std::vector<const TriMesh*>& meshes, const PrintSettings& settings,
                         const std::string& what) {
         PrintEstimate sum;
         for (size_t i = 0; i < meshes.size(); ++i) {
@@ -94,16 +99,16 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piece
                 what + " " + std::to_string(i) + " at " + fixed(settings.infillPercent, 0) + "%";
             if (options.source == EstimateSource::PrusaSlicer) {
                 try {
-                    sum += sliceWithPrusaSlicer(meshes[i], settings, label, options.slicer, context);
+                    sum += sliceWithPrusaSlicer(*meshes[i], settings, label, options.slicer, context);
                 } catch (const Error& e) {
                     if (e.code() != ErrorCode::ProcessingFailed) throw;
                     // One odd part should not void the whole report: say so and estimate it.
                     context.warn(std::string(e.what()) + "; the estimator's numbers are used for it");
                     report.slicerFallbacks.push_back(label);
-                    sum += estimatePrint(meshes[i], settings, options.rates);
+                    sum += estimatePrint(*meshes[i], settings, options.rates);
                 }
             } else {
-                sum += estimatePrint(meshes[i], settings, options.rates);
+                sum += estimatePrint(*meshes[i], settings, options.rates);
             }
             context.progress("report", double(++done) / double(total));
         }
@@ -122,7 +127,7 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piece
         c.zomefab.filament = filamentUse(c.zomefab.print.filamentMm3, options.filament);
         c.zomefab.assemblyHours = buildHours;
         c.zomefab.zomeUsd = zomeUsd;
-        c.baseline.print = printAll(baselineParts, settings, std::string(name) + " baseline part");
+        c.baseline.print = printAll(baselinePointers, settings, std::string(name) + " baseline part");
         c.baseline.filament = filamentUse(c.baseline.print.filamentMm3, options.filament);
         c.savedTimePercent = savedPercent(c.zomefab.totalHours(), c.baseline.totalHours());
         c.savedMaterialPercent = savedPercent(c.zomefab.totalUsd(), c.baseline.totalUsd());
@@ -139,8 +144,8 @@ nlohmann::json costReportToJson(const CostReport& r) {
     for (const CostCase& c : r.cases)
         cases.push_back({{"name", c.name},
                          {"infill_percent", c.infillPercent},
-                         {"zomefab", fabricationJson(c.zomefab)},
-                         {"baseline", fabricationJson(c.baseline)},
+                         {"zomefab", makingCostJson(c.zomefab)},
+                         {"baseline", makingCostJson(c.baseline)},
                          {"saved_time_percent", c.savedTimePercent},
                          {"saved_material_percent", c.savedMaterialPercent},
                          {"saved_filament_percent", c.savedFilamentPercent}});
@@ -153,7 +158,7 @@ nlohmann::json costReportToJson(const CostReport& r) {
             {"zometool", zome::partsListToJson(r.parts, o.prices)},
             {"cases", std::move(cases)},
             {"options",
-             {{"printer_mm", o.printerMm},
+             {{"printer_mm", r.printerMm},
               {"layer_height_mm", o.print.layerHeightMm},
               {"first_layer_height_mm", o.print.firstLayerHeightMm},
               {"nozzle_mm", o.print.nozzleMm},

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "zomefab/core/fabrication.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/core/tri_mesh.h"
 #include "zomefab/report/print_estimate.h"
@@ -39,13 +40,12 @@ struct CostOptions {
     FilamentOptions filament;
     zome::PriceOptions prices;  ///< Zometool prices (0.19 USD a strut, 0.29 USD a ball)
     AssemblyTimeOptions assembly;
-    Vec3d printerMm{200.0, 200.0, 200.0};  ///< printer volume; Ultimaker 3 in the paper (§7.1)
     EstimateSource source = EstimateSource::Estimator;
     SlicerOptions slicer;  ///< used when source == PrusaSlicer
 };
 
-/// One way of making the object.
-struct Fabrication {
+/// One way of making the object: what it costs.
+struct MakingCost {
     PrintEstimate print;         ///< summed over the printed parts
     FilamentUse filament;        ///< of print.filamentMm3
     double assemblyHours = 0.0;  ///< building the frame (0 for the baseline)
@@ -61,8 +61,8 @@ struct Fabrication {
 struct CostCase {
     std::string name;  ///< "hollow" or "solid"
     double infillPercent = 0.0;
-    Fabrication zomefab;
-    Fabrication baseline;
+    MakingCost zomefab;
+    MakingCost baseline;
     double savedTimePercent = 0.0;
     double savedMaterialPercent = 0.0;
     double savedFilamentPercent = 0.0;
@@ -75,6 +75,7 @@ struct CostReport {
     double objectVolumeMm3 = 0.0;
     double piecesVolumeMm3 = 0.0;
     zome::PartsList parts;
+    Vec3d printerMm = Fabrication{}.printerMm;  ///< the printer the baseline was cut for
     EstimateSource source = EstimateSource::Estimator;
     /// Parts the slicer failed on (e.g. "baseline part 3 at 20%"), estimated instead, each with a
     /// warning on the run context.
@@ -89,13 +90,13 @@ void checkCostOptions(const CostOptions& options);
 
 /// Builds the report. @p objectMm is the closed input object in mm as it would be printed whole
 /// (z up); @p piecesMm the closed pieces as they will be printed (print orientation); @p parts the
-/// frame's parts list. With EstimateSource::PrusaSlicer every piece and baseline part is sliced
+/// frame's parts list; the baseline is cut for the Fabrication's printer. With EstimateSource::PrusaSlicer every piece and baseline part is sliced
 /// (2 × (pieces + parts) slicer runs; progress through @p context); a part the slicer fails on is
 /// estimated instead, with a warning, and listed in CostReport::slicerFallbacks.
 /// @throw Error(Usage) for invalid options or a slicer that is not installed, as octreeParts(),
 ///   Error(Cancelled).
-CostReport costReport(const TriMesh& objectMm, const std::vector<TriMesh>& piecesMm,
-                      const zome::PartsList& parts, const CostOptions& options = {},
+CostReport costReport(const TriMesh& objectMm, const std::vector<const TriMesh*>& piecesMm,
+                      const zome::PartsList& parts, const Fabrication& fabrication, const CostOptions& options = {},
                       RunContext& context = RunContext::silent());
 
 /// The report as JSON (report.json's "cost" block): every number with its unit in the key.

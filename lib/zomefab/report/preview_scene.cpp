@@ -212,12 +212,12 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
         const int group = addGroup("pieces");
         for (size_t i = 0; i < input.pieces.size(); ++i) {
             const std::string name = input.pieceNames.empty() ? "piece-" + pad2(i) : input.pieceNames[i];
-            if (input.pieces[i].triangles.empty())
+            if (!input.pieces[i] || input.pieces[i]->triangles.empty())
                 throw Error(ErrorCode::Usage, "preview: " + name + " is empty");
             scene.materials.push_back(pieceMaterial(i, name));
             GlbMesh mesh;
             mesh.name = name;
-            mesh.geometry = input.pieces[i];
+            mesh.geometry = *input.pieces[i];
             mesh.geometry.salientFaces.clear();
             if (!input.pieceTransforms.empty()) transformInPlace(mesh.geometry, input.pieceTransforms[i]);
             mesh.material = int(scene.materials.size() - 1);

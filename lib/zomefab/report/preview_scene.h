@@ -18,7 +18,7 @@ namespace zomefab::report {
 
 /// What the preview shows. Everything in the model's millimetres, z up.
 struct PreviewInput {
-    std::vector<TriMesh> pieces;          ///< closed piece meshes
+    std::vector<const TriMesh*> pieces;   ///< closed piece meshes (not owned)
     std::vector<std::string> pieceNames;  ///< node names, one per piece; empty = "piece-00", ...
     /// Empty (the pieces already sit where they belong in the frame's mm), or one transform per
     /// piece taking it there, e.g. printer → frame mm: affineInverse(frameToGridMm) ·

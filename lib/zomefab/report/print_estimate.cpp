@@ -8,6 +8,7 @@
 #include <string>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/fabrication.h"
 #include "zomefab/report/mesh_clip.h"
 
 namespace zomefab::report {
@@ -128,16 +129,6 @@ PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const P
     return e;
 }
 
-bool fitsPrinter(const Vec3d& sizeMm, const Vec3d& printerMm) {
-    std::array<double, 3> a{sizeMm[0], sizeMm[1], sizeMm[2]}, b{printerMm[0], printerMm[1], printerMm[2]};
-    std::sort(a.begin(), a.end());
-    std::sort(b.begin(), b.end());
-    // Sorted sizes against sorted sizes: the best of the six axis permutations.
-    for (int i = 0; i < 3; ++i)
-        if (a[size_t(i)] > b[size_t(i)] + 1e-6) return false;
-    return true;
-}
-
 TriMesh orientOnBed(const TriMesh& part, const Vec3d& printerMm) {
     if (part.triangles.empty()) return part;
     const Box3d box = boundingBox(part);
@@ -205,7 +196,7 @@ void splitUntilFits(const TriMesh& part, const Box3d& cell, const Vec3d& printer
                     std::vector<TriMesh>& out, RunContext& context) {
     context.throwIfCancelled();
     if (part.triangles.empty()) return;
-    if (fitsPrinter(boundingBox(part).size(), printerMm)) {
+    if (boxFitsPrinter(boundingBox(part).size(), printerMm, 0.0, 1e-6)) {
         out.push_back(orientOnBed(part, printerMm));
         return;
     }

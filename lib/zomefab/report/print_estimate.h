@@ -109,7 +109,5 @@ std::vector<TriMesh> octreeParts(const TriMesh& object, const Vec3d& printerMm, 
 /// ties and parts without flat faces keep their orientation. Rotations are exact (axis swaps).
 TriMesh orientOnBed(const TriMesh& part, const Vec3d& printerMm);
 
-/// True when a box of size @p sizeMm fits in @p printerMm after some axis permutation.
-bool fitsPrinter(const Vec3d& sizeMm, const Vec3d& printerMm);
 
 }  // namespace zomefab::report

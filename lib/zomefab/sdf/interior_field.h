@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "zomefab/core/fabrication.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/core/tri_mesh.h"
 #include "zomefab/sdf/level_set.h"
@@ -19,8 +20,9 @@ namespace zomefab::sdf {
 
 /// Parameters of the forbidden zone F (paper §4.3.1; defaults are the paper's).
 struct ForbiddenZoneOptions {
-    double dMinMm = 16.0;  ///< = b0 / 3: nothing of the frame may come closer to the surface
-    double dMaxMm = 47.3;  ///< = b0, the shortest blue strut
+    /// Nothing of the frame may come closer to the surface (Fabrication::frameClearanceMm).
+    double dMinMm = Fabrication{}.frameClearanceMm;
+    double dMaxMm = Fabrication{}.frameReachMm();  ///< = b0, the shortest blue strut
     double fThick = 90.0;  ///< penalty closer than dMin (and outside the object)
     double fMax = 70.0;    ///< penalty at and beyond dMax
 };

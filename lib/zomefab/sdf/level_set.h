@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "zomefab/core/fabrication.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/core/transform.h"
 #include "zomefab/core/tri_mesh.h"
@@ -91,9 +92,6 @@ LevelSet meshToLevelSet(const TriMesh& meshMm, const MeshToLevelSetOptions& opti
 /// What zf-sdf builds from the scaled input mesh.
 struct ObjectFieldOptions {
     double voxelMm = 1.0;  ///< voxel of the "object" grid (see MeshToLevelSetOptions)
-    /// Depth of exact distances in the "object" grid: the thickest shell makeShell can cut from it.
-    /// Default: the paper's shell thickness dMin = 16 mm (§6, §4.3.1).
-    double shellDepthMm = 16.0;
     /// Voxel of the "interior" grid for the frame optimisation (exact distances over the whole
     /// inside); on the bunny at 400 mm 2 mm gives a 95th-percentile depth error of 0.08 mm at a
     /// quarter of the 1 mm build time and 1/8 of its memory (docs/sdf.md).
@@ -102,8 +100,8 @@ struct ObjectFieldOptions {
     double fieldExteriorMm = 10.0;
 };
 
-/// The object's distance fields: "object" (fine, band to shellDepthMm) and "interior" (coarse,
-/// whole inside), both in the mesh's millimetres.
+/// The object's distance fields: "object" (fine, exact as deep as the wall is thick) and
+/// "interior" (coarse, whole inside), both in the mesh's millimetres.
 struct ObjectField {
     LevelSet object;
     LevelSet interior;
@@ -113,25 +111,19 @@ struct ObjectField {
 ///        finite number of mm. Tools call it before reading input, so bad options fail fast.
 void checkObjectFieldOptions(const ObjectFieldOptions& options);
 
-/// Both grids of ObjectField from @p meshMm. @throw as checkObjectFieldOptions and meshToLevelSet.
-ObjectField makeObjectField(const TriMesh& meshMm, const ObjectFieldOptions& options, RunContext& context);
+/// Both grids of ObjectField from @p meshMm; the "object" grid is exact Fabrication::wallMm deep,
+/// which is what makeShell needs. @throw as checkObjectFieldOptions and meshToLevelSet.
+ObjectField makeObjectField(const TriMesh& meshMm, const Fabrication& fabrication, const ObjectFieldOptions& options,
+                            RunContext& context);
 
-/// The hollow shell {x : −shellMm ≤ φ(x) ≤ 0} (paper §6).
-struct ShellOptions {
-    /// Wall thickness; default dMin = 16 mm, the paper's choice (§6). Any value ≥ 1 mm.
-    double shellMm = 16.0;
-};
-
-/// @throw Error(Usage) unless shellMm is finite and ≥ 1 mm.
-void checkShellOptions(const ShellOptions& options);
-
-/// The shell as a level set: csgDifference of @p object and its inward offset {φ < −shellMm},
-/// the offset read from the object's deep interior band (no LevelSetFilter::offset).
-/// @throw Error(Usage) when shellMm < 1 mm or deeper than the object's interior band
-///        (info().interiorBandMm; rebuild the object with a larger shellDepthMm);
+/// The hollow shell {x : −wallMm ≤ φ(x) ≤ 0} (paper §6) of Fabrication::wallMm: csgDifference of
+/// @p object and its inward offset {φ < −wallMm}, the offset read from the object's deep interior
+/// band (no LevelSetFilter::offset).
+/// @throw Error(Usage) when the wall is under 1 mm or deeper than the object's interior band
+///        (info().interiorBandMm; rebuild the object with zf-sdf --shell-mm of this wall);
 ///        Error(ProcessingFailed) for an object with no inside; Error(Cancelled).
-/// Where the object is thinner than 2·shellMm the offset is empty and the shell is solid there.
-LevelSet makeShell(const LevelSet& object, const ShellOptions& options, RunContext& context);
+/// Where the object is thinner than 2·wallMm the offset is empty and the shell is solid there.
+LevelSet makeShell(const LevelSet& object, const Fabrication& fabrication, RunContext& context);
 
 /// Level set -> triangle mesh (openvdb::tools::volumeToMesh).
 struct LevelSetToMeshOptions {

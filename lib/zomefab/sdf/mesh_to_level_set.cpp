@@ -173,18 +173,19 @@ LevelSet meshToLevelSet(const TriMesh& mesh, const MeshToLevelSetOptions& option
 
 void checkObjectFieldOptions(const ObjectFieldOptions& options) {
     requirePositive(options.voxelMm, "the voxel size");
-    requirePositive(options.shellDepthMm, "the shell depth");
     requirePositive(options.fieldVoxelMm, "the interior field's voxel size");
     if (!(options.fieldExteriorMm >= 0) || !std::isfinite(options.fieldExteriorMm))
         throw Error(ErrorCode::Usage, "the interior field's exterior band must be ≥ 0 mm");
 }
 
-ObjectField makeObjectField(const TriMesh& meshMm, const ObjectFieldOptions& options, RunContext& context) {
+ObjectField makeObjectField(const TriMesh& meshMm, const Fabrication& fabrication, const ObjectFieldOptions& options,
+                            RunContext& context) {
+    checkFabrication(fabrication);
     checkObjectFieldOptions(options);
     ObjectField field;
     MeshToLevelSetOptions object;
     object.voxelMm = options.voxelMm;
-    object.interiorBandMm = options.shellDepthMm;
+    object.interiorBandMm = fabrication.wallMm;  // what makeShell reads
     object.name = "object";
     field.object = meshToLevelSet(meshMm, object, context);
     MeshToLevelSetOptions interior;

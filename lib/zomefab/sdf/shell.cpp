@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The hollow shell {−shellMm ≤ φ ≤ 0} (paper §6) by one CSG difference of two narrow bands cut
+// The hollow shell {−wallMm ≤ φ ≤ 0} (paper §6) by one CSG difference of two narrow bands cut
 // from the object's deep interior band. No LevelSetFilter::offset: measured here, a 3 mm offset
 // alone costs about 4× the whole mesh-to-volume conversion (issue 4); reading the offset surface
 // from a band that is already deep enough costs one pass over the voxels.
@@ -47,27 +47,22 @@ openvdb::FloatGrid::Ptr shiftedNarrowBand(const openvdb::FloatGrid& source, floa
 
 }  // namespace
 
-void checkShellOptions(const ShellOptions& options) {
-    if (!(std::isfinite(options.shellMm) && options.shellMm >= 1.0))
-        throw Error(ErrorCode::Usage,
-                    "the shell thickness must be at least 1 mm, got " + formatNumber(options.shellMm));
-}
-
-LevelSet makeShell(const LevelSet& object, const ShellOptions& options, RunContext& context) {
-    checkShellOptions(options);
+LevelSet makeShell(const LevelSet& object, const Fabrication& fabrication, RunContext& context) {
+    checkFabrication(fabrication);
+    const double wallMm = fabrication.wallMm;
     const LevelSetInfo& source = object.info();
-    if (options.shellMm > source.interiorBandMm * (1 + 1e-9)) {
-        throw Error(ErrorCode::Usage, "a " + formatNumber(options.shellMm) +
+    if (wallMm > source.interiorBandMm * (1 + 1e-9)) {
+        throw Error(ErrorCode::Usage, "a " + formatNumber(wallMm) +
                                           " mm shell needs exact distances that deep, but the '" +
                                           source.name + "' grid's interior band reaches " +
                                           formatNumber(source.interiorBandMm) +
-                                          " mm; rebuild it with a deeper band (zf-sdf --shell-depth-mm " +
-                                          formatNumber(options.shellMm) + ")");
+                                          " mm; rebuild it with a deeper band (zf-sdf --shell-mm " +
+                                          formatNumber(wallMm) + ")");
     }
     const openvdb::FloatGrid::ConstPtr grid = levelSetGrid(object);
     const double voxel = grid->voxelSize()[0];
-    if (options.shellMm < 2 * voxel) {
-        context.warn("the " + formatNumber(options.shellMm) + " mm shell is thinner than two " + formatNumber(voxel) +
+    if (wallMm < 2 * voxel) {
+        context.warn("the " + formatNumber(wallMm) + " mm shell is thinner than two " + formatNumber(voxel) +
                      " mm voxels; its walls may mesh with holes (use a smaller voxel)");
     }
     const float halfWidthMm = float(kHalfWidthVoxels * voxel);
@@ -77,7 +72,7 @@ LevelSet makeShell(const LevelSet& object, const ShellOptions& options, RunConte
     openvdb::FloatGrid::Ptr outer = shiftedNarrowBand(*grid, 0.0f, halfWidthMm);
     context.throwIfCancelled();
     context.progress("shell", 0.4);
-    openvdb::FloatGrid::Ptr inner = shiftedNarrowBand(*grid, float(options.shellMm), halfWidthMm);
+    openvdb::FloatGrid::Ptr inner = shiftedNarrowBand(*grid, float(wallMm), halfWidthMm);
     context.throwIfCancelled();
     context.progress("shell", 0.8);
     openvdb::tools::csgDifference(*outer, *inner);  // leaves the result in outer, inner empty
@@ -87,7 +82,7 @@ LevelSet makeShell(const LevelSet& object, const ShellOptions& options, RunConte
 
     LevelSetInfo info = source;
     info.name = "shell";
-    info.shellMm = options.shellMm;
+    info.shellMm = wallMm;
     info.exteriorBandMm = 0;
     info.interiorBandMm = 0;
     return wrapLevelSetGrid(std::move(outer), std::move(info));

@@ -67,6 +67,8 @@ json structureToJson(const Structure& s, const Transform4d& transformMm) {
     out["generator"] = generatorString();
     out["b0_mm"] = s.scale().b0Mm;
     out["unit_mm"] = s.scale().unitMm();
+    // Exactly, so a reader places every ball at the same millimetres, bit for bit.
+    out["origin_mm"] = toJson(s.scale().originMm);
     out["transform_mm"] = toJson(transformMm);
     json balls = json::array();
     for (BallId id : s.ballIds()) {
@@ -163,8 +165,10 @@ Structure structureFromJson(const json& j, const ZomeScale& physical, const Coll
         if (!exact) fail(ballLabel(value) + ": no \"exact\" position");
         entries.push_back({value, readExact(*exact, ballLabel(value)), member(b, "mm")});
     }
+    const json* origin = member(j, "origin_mm");
+    if (origin) scale.originMm = vec3FromJson(*origin, "origin_mm");
     for (const Entry& e : entries) {
-        if (!e.mm) continue;
+        if (!e.mm || origin) continue;
         const Vec3d mm = vec3FromJson(*e.mm, ballLabel(e.id) + ": mm");
         const Vec3d p = e.exact.toDouble();
         const double u = scale.unitMm();

@@ -17,6 +17,7 @@
 #include <string_view>
 #include <utility>
 
+#include "zomefab/core/fabrication.h"
 #include "zomefab/core/tri_mesh.h"
 #include "zomefab/zome/golden.h"
 
@@ -109,7 +110,7 @@ std::optional<int> parallelHole(const GoldenVector3& v);
 /// ball diameter; capsule radii of the strut cross-sections from vZome's part models, rounded up
 /// (docs/zome.md §3 lists sources).
 struct ZomeScale {
-    double b0Mm = 47.3;             ///< B0 centre-to-centre (paper §4.2: b0 = 47.3; vZome nominal 46.27)
+    double b0Mm = Fabrication{}.b0Mm;  ///< B0 centre-to-centre (paper §4.2: b0 = 47.3; vZome nominal 46.27)
     double ballDiameterMm = 17.7;   ///< ball width across the blue holes (ZomeFab NODE_DIAMETER)
     double blueRadiusMm = 3.3;      ///< blue capsule radius (5.46 × 3.38 mm rectangle, circumradius 3.21)
     double yellowRadiusMm = 3.2;    ///< yellow capsule radius (lifelike model max radius 3.15)

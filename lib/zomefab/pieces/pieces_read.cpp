@@ -1,0 +1,192 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// pieces.json read back: the inverse of piecesToJson (pieces_io.cpp), for zf-preview, the
+// installation checks and anything else that starts from a pieces directory.
+#include <filesystem>
+
+#include "zomefab/core/error.h"
+#include "zomefab/core/json_values.h"
+#include "zomefab/core/vec.h"
+#include "zomefab/io/file_io.h"
+#include "zomefab/io/mesh_io.h"
+#include "zomefab/pieces/pieces_io.h"
+
+namespace zomefab::pieces {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+[[noreturn]] void fail(const std::string& what) { throw Error(ErrorCode::InvalidInput, what); }
+
+/// @p j[@p key] read by @p read when present, else @p fallback: the reader is strict on what a
+/// file means and lenient on what it can do without (a hand-written pieces.json for zf-preview).
+template <class T, class Read>
+T optionalField(const json& j, const char* key, T fallback, Read&& read) {
+    return j.is_object() && j.contains(key) ? read(j[key]) : fallback;
+}
+
+uint32_t indexFromJson(const json& j, const std::string& what) {
+    if (!j.is_number_unsigned() || j.get<uint64_t>() > 0xFFFFFFFEull) fail(what + " must be an index");
+    return j.get<uint32_t>();
+}
+
+int intFromJson(const json& j, const std::string& what) {
+    if (!j.is_number_integer() || j.get<int64_t>() < -1000000 || j.get<int64_t>() > 1000000)
+        fail(what + " must be an integer");
+    return j.get<int>();
+}
+
+std::vector<uint32_t> indicesFromJson(const json& j, const std::string& what) {
+    if (!j.is_array()) fail(what + " must be a list of indices");
+    std::vector<uint32_t> out;
+    for (size_t i = 0; i < j.size(); ++i) out.push_back(indexFromJson(j[i], what));
+    return out;
+}
+
+void readOptions(const json& o, PiecesOptions& options) {
+    const std::string what = "options";
+    options.minPieceVolumeMm3 = numberFromJson(requireMember(o, "min_piece_volume_mm3", what), what);
+    options.adaptivity = numberFromJson(requireMember(o, "adaptivity", what), what);
+    const json& t = requireMember(o, "tenons", what);
+    TenonOptions& to = options.tenons;
+    to.minPerPiece = intFromJson(requireMember(t, "min_per_piece", "tenons"), "tenons.min_per_piece");
+    to.maxPerPiece = intFromJson(requireMember(t, "max_per_piece", "tenons"), "tenons.max_per_piece");
+    to.clearanceMm = numberFromJson(requireMember(t, "clearance_mm", "tenons"), "tenons.clearance_mm");
+    const json& hole = requireMember(t, "hole_mm", "tenons");
+    if (!hole.is_array() || hole.size() != 2) fail("tenons.hole_mm must be [long, short]");
+    to.holeLongMm = numberFromJson(hole[0], "tenons.hole_mm");
+    to.holeShortMm = numberFromJson(hole[1], "tenons.hole_mm");
+    to.pegDepthMm = numberFromJson(requireMember(t, "peg_depth_mm", "tenons"), "tenons.peg_depth_mm");
+    to.bodyWidthMm = numberFromJson(requireMember(t, "width_mm", "tenons"), "tenons.width_mm");
+    to.maxLengthMm = numberFromJson(requireMember(t, "max_length_mm", "tenons"), "tenons.max_length_mm");
+    to.maxTiltDeg = numberFromJson(requireMember(t, "max_tilt_deg", "tenons"), "tenons.max_tilt_deg");
+    to.embedMm = numberFromJson(requireMember(t, "embed_mm", "tenons"), "tenons.embed_mm");
+    to.frameClearanceMm = numberFromJson(requireMember(t, "frame_clearance_mm", "tenons"), "tenons.frame_clearance_mm");
+    to.latticeHolesOnly = t.value("holes", "blue") == "lattice";
+}
+
+Tenon tenonFromJson(const json& j, uint32_t piece, const std::string& what) {
+    Tenon t;
+    t.piece = piece;
+    t.ball = indexFromJson(requireMember(j, "ball", what), what + ".ball");
+    t.hole = intFromJson(requireMember(j, "hole", what), what + ".hole");
+    if (t.hole < 0 || t.hole >= 62) fail(what + ".hole must be in 0..61");
+    t.axisFrame = vec3FromJson(requireMember(j, "axis_frame", what), what + ".axis_frame");
+    t.axisGrid = vec3FromJson(requireMember(j, "axis_mm", what), what + ".axis_mm");
+    t.longSideGrid = vec3FromJson(requireMember(j, "peg_long_side_mm", what), what + ".peg_long_side_mm");
+    t.ballCenterGridMm = vec3FromJson(requireMember(j, "ball_center_mm", what), what + ".ball_center_mm");
+    // The distances along the axis, from the points written.
+    auto along = [&](const char* key) {
+        return dot(sub(vec3FromJson(requireMember(j, key, what), what + "." + key), t.ballCenterGridMm), t.axisGrid);
+    };
+    t.pegTipMm = along("peg_tip_mm");
+    t.shoulderMm = along("shoulder_mm");
+    t.baseMm = along("base_mm");
+    t.endMm = along("end_mm");
+    t.tiltDeg = numberFromJson(requireMember(j, "tilt_deg", what), what + ".tilt_deg");
+    return t;
+}
+
+void readOrientation(const json& o, Piece& piece, const std::string& what) {
+    auto vec = [&](const char* key) { return [&, key](const json& v) { return vec3FromJson(v, what + "." + key); }; };
+    piece.gridToPrintMm = optionalField(o, "transform_mm", Transform4d::identity(),
+                                        [&](const json& v) { return transformFromJson(v, what + ".transform_mm"); });
+    piece.isCutFaceDown = o.value("cut_face_down", false);
+    piece.downNormalGridMm = optionalField(o, "down_normal", Vec3d{0, 0, -1}, vec("down_normal"));
+    piece.baseAreaMm2 = optionalField(o, "base_area_mm2", 0.0,
+                                      [&](const json& v) { return numberFromJson(v, what + ".base_area_mm2"); });
+    piece.extentsMm = optionalField(o, "extents_mm", Vec3d{0, 0, 0}, vec("extents_mm"));
+}
+
+Piece pieceFromJson(const json& j, size_t index, const std::string& directory) {
+    const std::string what = "pieces[" + std::to_string(index) + "]";
+    if (!j.is_object()) fail(what + " must be an object");
+    Piece piece;
+    auto number = [&](const char* key) { return [&, key](const json& v) { return numberFromJson(v, what + "." + key); }; };
+    auto indices = [&](const char* key) { return [&, key](const json& v) { return indicesFromJson(v, what + "." + key); }; };
+    piece.id = optionalField(j, "piece", uint32_t(index), [&](const json& v) { return indexFromJson(v, what + ".piece"); });
+    piece.volumeMm3 = optionalField(j, "volume_mm3", 0.0, number("volume_mm3"));
+    piece.shellVolumeMm3 = optionalField(j, "shell_volume_mm3", 0.0, number("shell_volume_mm3"));
+    piece.gridBoundsMm =
+        optionalField(j, "grid_bbox_mm", Box3d{}, [&](const json& v) { return boxFromJson(v, what + ".grid_bbox_mm"); });
+    readOrientation(j.value("orientation", json::object()), piece, what + ".orientation");
+    piece.cells = optionalField(j, "cells", std::vector<uint32_t>{}, indices("cells"));
+    piece.requests = optionalField(j, "partition_pieces", std::vector<uint32_t>{}, indices("partition_pieces"));
+    for (const json& n : j.value("neighbors", json::array()))
+        piece.neighbors.push_back({indexFromJson(requireMember(n, "piece", what), what + ".neighbors"),
+                                   numberFromJson(requireMember(n, "contact_mm2", what), what + ".neighbors")});
+    piece.sliversMerged = optionalField(j, "slivers_merged", uint32_t(0),
+                                        [&](const json& v) { return indexFromJson(v, what + ".slivers_merged"); });
+    const json tenons = j.value("tenons", json::array());
+    if (!tenons.is_array()) fail(what + ".tenons must be a list");
+    for (size_t t = 0; t < tenons.size(); ++t)
+        piece.tenons.push_back(tenonFromJson(tenons[t], piece.id, what + ".tenons[" + std::to_string(t) + "]"));
+    const json& shortfall = j.value("tenon_shortfall", json());
+    if (shortfall.is_object() && shortfall.contains("reasons") && shortfall["reasons"].is_object())
+        for (const auto& [why, count] : shortfall["reasons"].items())
+            piece.tenonShortfall[why] = intFromJson(count, what + ".tenon_shortfall");
+    const json& label = j.value("label", json());
+    if (label.is_object()) {
+        PieceLabel l;
+        l.text = label.value("text", "");
+        l.centerGridMm = vec3FromJson(requireMember(label, "center_mm", what), what + ".label.center_mm");
+        l.normalGrid = vec3FromJson(requireMember(label, "normal", what), what + ".label.normal");
+        l.upGrid = vec3FromJson(requireMember(label, "up", what), what + ".label.up");
+        const json& size = requireMember(label, "size_mm", what);
+        if (!size.is_array() || size.size() != 2) fail(what + ".label.size_mm must be [width, height]");
+        l.widthMm = numberFromJson(size[0], what + ".label.size_mm");
+        l.heightMm = numberFromJson(size[1], what + ".label.size_mm");
+        piece.label = l;
+    }
+    if (j.contains("label_note") && j["label_note"].is_string()) piece.labelNote = j["label_note"].get<std::string>();
+    const json& file = requireMember(j, "file", what);
+    if (!file.is_string() || file.get<std::string>().find('/') != std::string::npos)
+        fail(what + ".file must be a file name next to pieces.json");
+    if (!directory.empty()) piece.mesh = readMesh((fs::path(directory) / file.get<std::string>()).string());
+    return piece;
+}
+
+}  // namespace
+
+Pieces piecesFromJson(const json& j, const std::string& directory) {
+    if (!j.is_object() || j.value("format", "") != kPiecesFormatName)
+        fail(std::string("not a pieces file (format is not \"") + kPiecesFormatName + "\")");
+    if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<int>() != kPiecesFormatVersion)
+        fail("unsupported pieces file version (expected " + std::to_string(kPiecesFormatVersion) + ")");
+    Pieces out;
+    out.printerMm = optionalField(j, "printer_mm", out.printerMm, [](const json& v) { return vec3FromJson(v, "printer_mm"); });
+    out.voxelMm = optionalField(j, "voxel_mm", 0.0, [](const json& v) { return numberFromJson(v, "voxel_mm"); });
+    auto transform = [](const char* key) { return [key](const json& v) { return transformFromJson(v, key); }; };
+    out.gridTransformMm = optionalField(j, "grid_transform_mm", Transform4d::identity(), transform("grid_transform_mm"));
+    out.frameToGridMm = optionalField(j, "frame_to_grid_mm", Transform4d::identity(), transform("frame_to_grid_mm"));
+    if (j.contains("options")) readOptions(j["options"], out.options);
+    const json& pieces = requireMember(j, "pieces", "pieces file");
+    if (!pieces.is_array()) fail("pieces must be a list");
+    for (size_t i = 0; i < pieces.size(); ++i) {
+        out.pieces.push_back(pieceFromJson(pieces[i], i, directory));
+        if (out.pieces.back().id != i) fail("pieces[" + std::to_string(i) + "].piece must be " + std::to_string(i));
+    }
+    const json& summary = j.value("summary", json::object());
+    out.shellVolumeMm3 = summary.value("shell_volume_mm3", 0.0);
+    out.outsideCellsVolumeMm3 = summary.value("outside_cells_volume_mm3", 0.0);
+    out.sliversMerged = summary.value("slivers_merged", size_t(0));
+    out.isolatedSlivers = summary.value("isolated_slivers", size_t(0));
+    return out;
+}
+
+Pieces readPieces(const std::string& path) {
+    std::error_code ec;
+    const std::string file = fs::is_directory(path, ec) ? (fs::path(path) / kPiecesFile).string() : path;
+    const json j = json::parse(readInputBytes(file), nullptr, false);
+    if (j.is_discarded()) throw Error(ErrorCode::InvalidInput, "invalid JSON", file);
+    try {
+        return piecesFromJson(j, fs::path(file).parent_path().string().empty() ? "." : fs::path(file).parent_path().string());
+    } catch (const Error& e) {
+        throw e.withFile(file);
+    } catch (const json::exception& e) {
+        throw Error(ErrorCode::InvalidInput, std::string("malformed pieces file: ") + e.what(), file);
+    }
+}
+
+}  // namespace zomefab::pieces

@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The writers of a run's output directory: each file comes from the writer its stage tool uses.
+#include <algorithm>
+#include <filesystem>
+#include <functional>
+
+#include "zomefab/core/error.h"
+#include "zomefab/io/file_io.h"
+#include "zomefab/partition/partition_json.h"
+#include "zomefab/pieces/pieces_io.h"
+#include "zomefab/pipeline/pipeline.h"
+#include "zomefab/report/run_report.h"
+#include "zomefab/zome/structure_json.h"
+
+namespace zomefab::pipeline {
+
+std::vector<std::string> writeRunOutputs(const report::RunRecord& run, const RunOptions& options,
+                                         const nlohmann::json& report, const std::string& outDir) {
+    StagedDirectory staged(outDir, kRunMarkerFile);
+    std::vector<std::string> written;
+    auto write = [&](const std::string& name, const std::function<void(std::ostream&)>& body) {
+        writeOutputAtomic(staged.file(name), body);
+        written.push_back(name);
+    };
+    write("frame.json", [&](std::ostream& out) {
+        out << zome::structureToJson(run.frame.structure, run.frameTransformMm).dump(1) << '\n';
+    });
+    write("frame.vef", [&](std::ostream& out) { out << zome::structureToVef(run.frame.structure); });
+    write("partition.json", [&](std::ostream& out) {
+        const partition::PartitionJsonInfo info{run.sourceName, "frame.json", run.frameTransformMm,
+                                                run.surfaceFrameMm.vertexCount()};
+        out << partition::partitionToJson(run.partition, options.partition, info).dump(1) << '\n';
+    });
+    std::error_code ec;
+    if (!std::filesystem::create_directory(staged.file("pieces"), ec))
+        throw Error(ErrorCode::WriteFailed, "cannot create the directory: " + ec.message(), staged.file("pieces"));
+    pieces::writePieceFiles(run.pieces, staged.file("pieces"), {run.sourceName, "frame.json", "partition.json"});
+    written.push_back("pieces/");
+    // The 3MF holds every piece: one file to open in a slicer, next to the preview, not among the STLs.
+    pieces::writePiecesThreeMf(run.pieces, staged.file("pieces.3mf"));
+    written.push_back("pieces.3mf");
+    report::writePreview(report::previewInput(run), staged.file("preview.glb"), options.preview);
+    written.push_back("preview.glb");
+    write("assembly.md", [&](std::ostream& out) { out << report::assemblyGuideMarkdown(run.assembly, options.cost.prices); });
+    write("cost.md", [&](std::ostream& out) { out << report::costPage(run); });
+    write(kRunMarkerFile, [&](std::ostream& out) { out << report.dump(2) << '\n'; });
+    staged.commit();
+    std::sort(written.begin(), written.end());
+    return written;
+}
+
+}  // namespace zomefab::pipeline

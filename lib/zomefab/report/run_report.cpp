@@ -1,0 +1,195 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "zomefab/report/run_report.h"
+
+#include <filesystem>
+
+#include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
+#include "zomefab/core/json_values.h"
+#include "zomefab/core/version.h"
+#include "zomefab/pieces/pieces_io.h"
+#include "zomefab/zome/parts.h"
+
+namespace zomefab::report {
+
+using nlohmann::json;
+
+namespace {
+
+std::string frameLine(const RunRecord& run) {
+    const zome::PartsList& parts = run.cost.parts;
+    size_t tenons = 0, fewTenons = 0;
+    for (const pieces::Piece& piece : run.pieces.pieces) {
+        tenons += piece.tenons.size();
+        fewTenons += !piece.tenonShortfall.empty();
+    }
+    const Vec3d& size = run.scaled.sizeMm;
+    return formatNumbers("%.0f x %.0f x %.0f mm", size[0], size[1], size[2]) + ": frame of " +
+           std::to_string(parts.balls) + " balls and " + std::to_string(parts.strutTotal()) + " struts (" +
+           std::to_string(run.assembly.layers) + " layers to build), " + std::to_string(run.pieces.pieces.size()) +
+           " printed pieces with " + std::to_string(tenons) + " tenons" +
+           (fewTenons ? " (" + std::to_string(fewTenons) + " pieces with fewer than planned)" : "");
+}
+
+std::string costLine(const CostCase& c) {
+    return c.name + formatNumbers(" (%.0f%% infill): ", c.infillPercent) +
+           formatNumbers("print %.1f h, %.2f kg, %.2f USD", c.zomefab.print.hours(), c.zomefab.filament.massG / 1000.0,
+                         c.zomefab.filament.costUsd) +
+           formatNumbers(" + Zometool %.2f USD, %.1f h to build", c.zomefab.zomeUsd, c.zomefab.assemblyHours) +
+           formatNumbers("; whole object %.1f h, %.2f USD", c.baseline.print.hours(), c.baseline.totalUsd()) +
+           formatNumbers(": saves %.0f%% time, %.0f%% material", c.savedTimePercent, c.savedMaterialPercent);
+}
+
+json levelSetsJson(const RunRecord& run) {
+    return {{"object", {{"voxel_mm", run.field.object.info().voxelMm},
+                        {"active_voxels", run.field.object.activeVoxelCount()}}},
+            {"interior", {{"voxel_mm", run.field.interior.info().voxelMm},
+                          {"active_voxels", run.field.interior.activeVoxelCount()}}},
+            {"shell", {{"shell_mm", run.fabrication.wallMm}, {"active_voxels", run.shell.activeVoxelCount()}}}};
+}
+
+json frameJson(const RunRecord& run) {
+    const zome::PartsList parts = zome::partsList(run.frame.structure);
+    return {{"balls", parts.balls},
+            {"struts", parts.strutTotal()},
+            {"parts", zome::partsListToJson(parts)},
+            {"energy_initial", run.frame.initialEnergy.total},
+            {"energy_final", run.frame.finalEnergy.total},
+            {"chains", run.frame.chains.size()},
+            {"rotation_deg", run.frame.rotationDeg},
+            {"metrics", frame::metricsToJson(run.frameMetrics)}};
+}
+
+json partitionJson(const RunRecord& run) {
+    const partition::PartitionResult& p = run.partition;
+    return {{"pieces", p.pieces.size()},
+            {"nearest_ball_partitions", p.nearestPartitions},
+            {"graph_cut_partitions", p.graphCutPartitions},
+            {"smoothness_weight", p.smoothnessWeight},
+            {"energy_nearest", p.energyNearest},
+            {"energy_graph_cut", p.energyGraphCut},
+            {"printer_mm", p.printerMm}};
+}
+
+json piecesJson(const RunRecord& run) {
+    size_t tenons = 0;
+    double volumeMm3 = 0;
+    for (const pieces::Piece& piece : run.pieces.pieces) {
+        tenons += piece.tenons.size();
+        volumeMm3 += piece.volumeMm3;
+    }
+    return {{"count", run.pieces.pieces.size()},
+            {"tenons", tenons},
+            {"volume_mm3", volumeMm3},
+            {"shell_volume_mm3", run.pieces.shellVolumeMm3},
+            {"slivers_merged", run.pieces.sliversMerged}};
+}
+
+json costJson(const RunRecord& run) {
+    json cost = costReportToJson(run.cost);
+    // The headline numbers (paper Table 1's "Efficiency (Saved)" columns), flat for batch summaries.
+    for (const CostCase& c : run.cost.cases) {
+        cost["time_saved_" + c.name + "_percent"] = c.savedTimePercent;
+        cost["material_saved_" + c.name + "_percent"] = c.savedMaterialPercent;
+        cost["filament_saved_" + c.name + "_percent"] = c.savedFilamentPercent;
+    }
+    return cost;
+}
+
+}  // namespace
+
+RunReports reportStage(const zome::Structure& frame, const pieces::Pieces& all, const TriMesh& objectMm,
+                       const Fabrication& fabrication, const CostOptions& options, RunContext& context) {
+    std::vector<TenonLink> links;
+    std::vector<std::string> names;
+    std::vector<const TriMesh*> printed;
+    for (size_t i = 0; i < all.pieces.size(); ++i) {
+        const pieces::Piece& piece = all.pieces[i];
+        names.push_back(pieces::pieceName(all, i));
+        printed.push_back(&piece.mesh);
+        for (const pieces::Tenon& tenon : piece.tenons) links.push_back({names.back(), tenon.ball, tenon.hole});
+    }
+    RunReports reports;
+    reports.assembly = assemblyGuide(frame, links, names);
+    reports.cost = costReport(objectMm, printed, zome::partsList(frame), fabrication, options, context);
+    return reports;
+}
+
+std::vector<std::string> runSummaryLines(const RunRecord& run) {
+    std::vector<std::string> lines{frameLine(run)};
+    for (const CostCase& c : run.cost.cases) lines.push_back(costLine(c));
+    return lines;
+}
+
+json runReportJson(const RunRecord& run, const RunContext& context) {
+    json report;
+    report["format"] = kReportFormatName;
+    report["version"] = kReportFormatVersion;
+    report["generator"] = generatorString();
+    report["input"] = {{"file", run.sourceName},
+                       {"triangles", run.inputReport.triangleCount},
+                       {"vertices", run.inputReport.vertexCount},
+                       {"size_mm", run.scaled.sizeMm},
+                       {"transform_mm", toJson(run.scaled.transformMm)}};
+    report["level_sets"] = levelSetsJson(run);
+    report["frame"] = frameJson(run);
+    report["partition"] = partitionJson(run);
+    report["pieces"] = piecesJson(run);
+    report["assembly"] = {{"layers", run.assembly.layers}, {"components", run.assembly.components}, {"file", "assembly.md"}};
+    report["cost"] = costJson(run);
+    json timings = json::array();
+    for (const StageTiming& t : run.timings) timings.push_back({{"stage", t.stage}, {"seconds", t.seconds}});
+    report["timings"] = timings;
+    report["seconds"] = run.totalSeconds;
+    report["peak_rss_bytes"] = peakRssBytes();
+    report["warnings"] = context.warnings();
+    return report;
+}
+
+std::string costPage(const RunRecord& run) {
+    std::string page = "# Cost and time: " + std::filesystem::path(run.sourceName).filename().string() + "\n\n";
+    for (const std::string& line : runSummaryLines(run)) page += "- " + line + "\n";
+    return page + "\n" + costReportMarkdown(run.cost);
+}
+
+json previewExtras(const std::string& sourceName, const Vec3d& sizeMm) {
+    return {{"source", sourceName}, {"size_mm", sizeMm}};
+}
+
+PreviewInput previewInput(const pieces::Pieces& all, const zome::Structure& frame) {
+    PreviewInput input;
+    const Transform4d gridToFrameMm = affineInverse(all.frameToGridMm);
+    for (size_t i = 0; i < all.pieces.size(); ++i) {
+        const pieces::Piece& piece = all.pieces[i];
+        input.pieces.push_back(&piece.mesh);
+        input.pieceNames.push_back(pieces::pieceName(all, i));
+        input.pieceTransforms.push_back(gridToFrameMm * affineInverse(piece.gridToPrintMm));
+    }
+    input.frame = &frame;
+    return input;
+}
+
+PreviewInput previewInput(const RunRecord& run) {
+    PreviewInput input = previewInput(run.pieces, run.frame.structure);
+    input.extras = previewExtras(run.sourceName, run.scaled.sizeMm);
+    return input;
+}
+
+RunSummary runSummaryFromJson(const json& report) {
+    if (!report.is_object() || report.value("format", "") != kReportFormatName)
+        throw Error(ErrorCode::InvalidInput, std::string("not a run report (format is not \"") + kReportFormatName + "\")");
+    RunSummary s;
+    s.peakRssBytes = report.value("peak_rss_bytes", size_t(0));
+    const json frame = report.value("frame", json::object());
+    s.balls = frame.value("balls", size_t(0));
+    s.struts = frame.value("struts", size_t(0));
+    s.pieces = report.value("partition", json::object()).value("pieces", size_t(0));
+    const json cost = report.value("cost", json::object());
+    if (cost.contains("material_saved_hollow_percent") && cost["material_saved_hollow_percent"].is_number()) {
+        s.hasMaterialSaved = true;
+        s.materialSavedPercent = cost["material_saved_hollow_percent"].get<double>();
+    }
+    return s;
+}
+
+}  // namespace zomefab::report
