@@ -7,7 +7,8 @@
 /// seams move (docs/benchmarks.md, "Partition").
 ///
 ///   bench_partition [bunny|million|compare|compare-million|all] [--compare-graph-nodes G]
-///                   [--compare-refine-nodes R] [--compare-w-smoothness W] [--threads N] [--k K] [--svm-cost C] [--svm-eps E]
+///                   [--compare-refine-nodes R] [--compare-w-smoothness W] [--threads N] [--k K] [--svm-cost
+///                   C] [--svm-eps E]
 ///                   [--svm-max-samples N] [--graph-nodes N] [--refine-nodes N] [--whole-surface-schedule]
 #include <tbb/global_control.h>
 
@@ -36,27 +37,35 @@ std::string dataFile(const char* name) { return std::string(ZOMEFAB_DATA_DIR) + 
 /// Process CPU time (all threads), seconds.
 double cpuSeconds() { return double(std::clock()) / CLOCKS_PER_SEC; }
 
-void report(const char* title, const TriMesh& mesh, const std::vector<zome::BallId>& labels, const PartitionResult& r,
-            double seconds, double cpu) {
+void report(const char* title, const TriMesh& mesh, const std::vector<zome::BallId>& labels,
+            const PartitionResult& r, double seconds, double cpu) {
     std::printf("%s\n", title);
-    std::printf("  faces %zu, labels %zu (outermost balls), k-nearest candidates: %zu graph nodes x labels = %zu pairs\n",
-                mesh.triangles.size(), labels.size(), r.graphNodes, r.candidatePairs);
+    std::printf(
+        "  faces %zu, labels %zu (outermost balls), k-nearest candidates: %zu graph nodes x labels = %zu "
+        "pairs\n",
+        mesh.triangles.size(), labels.size(), r.graphNodes, r.candidatePairs);
     for (const ScheduleStep& s : r.schedule) {
-        std::printf("  w_smoothness %-8g faces %zu  E %.6g -> %.6g  partitions %zu  kept %zu  oversized %zu  sweeps %d  "
-                    "expansions %d  %.2f s\n",
-                    s.smoothnessWeight, s.faces, s.energyNearest, s.energyGraphCut, s.partitions, s.kept, s.oversized,
-                    s.sweeps, s.expansions, s.seconds);
+        std::printf(
+            "  w_smoothness %-8g faces %zu  E %.6g -> %.6g  partitions %zu  kept %zu  oversized %zu  sweeps "
+            "%d  "
+            "expansions %d  %.2f s\n",
+            s.smoothnessWeight, s.faces, s.energyNearest, s.energyGraphCut, s.partitions, s.kept, s.oversized,
+            s.sweeps, s.expansions, s.seconds);
         if (s.bandNodes > 0)
-            std::printf("    clusters: E %.6g after %d sweeps, %d expansions; refinement band %zu of %zu nodes\n",
-                        s.energyClusters, s.clusterSweeps, s.clusterExpansions, s.bandNodes, r.refineNodes);
+            std::printf(
+                "    clusters: E %.6g after %d sweeps, %d expansions; refinement band %zu of %zu nodes\n",
+                s.energyClusters, s.clusterSweeps, s.clusterExpansions, s.bandNodes, r.refineNodes);
     }
-    std::printf("  partitions: nearest ball %zu, graph cut %zu; cells %zu, pieces %zu (splits %zu, merges %zu)\n",
-                r.nearestPartitions, r.graphCutPartitions, r.cells.cellCount(), r.pieces.size(), r.splits, r.merges);
+    std::printf(
+        "  partitions: nearest ball %zu, graph cut %zu; cells %zu, pieces %zu (splits %zu, merges %zu)\n",
+        r.nearestPartitions, r.graphCutPartitions, r.cells.cellCount(), r.pieces.size(), r.splits, r.merges);
     double worst = 0.0;
     for (const Piece& p : r.pieces) worst = std::max(worst, p.fit.ratio);
-    std::printf("  svm samples %zu, agreement %.4f; largest piece fit ratio %.3f\n", r.svmSamples, r.svmAgreement, worst);
-    std::printf("  seconds: graph cut + fit schedule %.2f, svm + pieces %.2f, partitionSurface %.2f wall, %.2f CPU\n",
-                r.secondsGraphCut, r.secondsSvm, seconds, cpu);
+    std::printf("  svm samples %zu, agreement %.4f; largest piece fit ratio %.3f\n", r.svmSamples,
+                r.svmAgreement, worst);
+    std::printf(
+        "  seconds: graph cut + fit schedule %.2f, svm + pieces %.2f, partitionSurface %.2f wall, %.2f CPU\n",
+        r.secondsGraphCut, r.secondsSvm, seconds, cpu);
 }
 
 /// Seam faces: faces with a neighbour in another piece.
@@ -72,11 +81,13 @@ std::vector<uint32_t> seamFaces(const FaceGraph& g, const std::vector<uint32_t>&
 }
 
 /// Mean and max distance from seam faces of @p a to the nearest seam face of @p b (mm), by a grid.
-std::pair<double, double> seamDistance(const FaceGraph& g, const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+std::pair<double, double> seamDistance(const FaceGraph& g, const std::vector<uint32_t>& a,
+                                       const std::vector<uint32_t>& b) {
     const double cell = 10.0;
     std::map<std::array<int, 3>, std::vector<uint32_t>> grid;
     auto key = [&](const Vec3d& p) {
-        return std::array<int, 3>{int(std::floor(p[0] / cell)), int(std::floor(p[1] / cell)), int(std::floor(p[2] / cell))};
+        return std::array<int, 3>{int(std::floor(p[0] / cell)), int(std::floor(p[1] / cell)),
+                                  int(std::floor(p[2] / cell))};
     };
     for (uint32_t f : b) grid[key(g.centroidsMm[f])].push_back(f);
     double sum = 0.0, worst = 0.0;
@@ -93,8 +104,9 @@ std::pair<double, double> seamDistance(const FaceGraph& g, const std::vector<uin
                         if (it == grid.end()) continue;
                         for (uint32_t h : it->second) {
                             const Vec3d& q = g.centroidsMm[h];
-                            best = std::min(best, (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-                                                      (p[2] - q[2]) * (p[2] - q[2]));
+                            best =
+                                std::min(best, (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                                                   (p[2] - q[2]) * (p[2] - q[2]));
                         }
                     }
         const double d = std::sqrt(best);
@@ -140,7 +152,8 @@ int main(int argc, char** argv) {
             mode = argv[i];
     }
     std::unique_ptr<tbb::global_control> limit;
-    if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+    if (threads > 0)
+        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
 
     const test::MeshMm bunny = test::loadMeshMm(dataFile("bunny_cgal_75k.stl"), 400.0, true);
     const test::LatticeFrame frame = test::makeLatticeFrame(bunny.mesh, 12.0);
@@ -150,7 +163,8 @@ int main(int argc, char** argv) {
         // The default run against one with other graph sizes or another first w_smoothness.
         double cpu = cpuSeconds();
         const Stopwatch w;
-        const PartitionResult r = partitionSurface(mesh, frame.structure, frame.outermost, Fabrication{}, o, RunContext::silent());
+        const PartitionResult r =
+            partitionSurface(mesh, frame.structure, frame.outermost, Fabrication{}, o, RunContext::silent());
         report(what, mesh, frame.outermost, r, w.seconds(), cpuSeconds() - cpu);
         PartitionOptions fine = o;
         fine.graphNodeTarget = compareGraphNodes;
@@ -158,11 +172,13 @@ int main(int argc, char** argv) {
         if (compareSmoothness > 0) fine.smoothnessStart = compareSmoothness;
         cpu = cpuSeconds();
         const Stopwatch w2;
-        const PartitionResult rf = partitionSurface(mesh, frame.structure, frame.outermost, Fabrication{}, fine, RunContext::silent());
-        std::printf("comparison run: graph nodes %zu, refinement nodes %zu (0 = faces / one level), w_smoothness %g\n",
-                    fine.graphNodeTarget, fine.refineNodeTarget, fine.smoothnessStart);
-        report("same, comparison run",
-               mesh, frame.outermost, rf, w2.seconds(), cpuSeconds() - cpu);
+        const PartitionResult rf = partitionSurface(mesh, frame.structure, frame.outermost, Fabrication{},
+                                                    fine, RunContext::silent());
+        std::printf(
+            "comparison run: graph nodes %zu, refinement nodes %zu (0 = faces / one level), w_smoothness "
+            "%g\n",
+            fine.graphNodeTarget, fine.refineNodeTarget, fine.smoothnessStart);
+        report("same, comparison run", mesh, frame.outermost, rf, w2.seconds(), cpuSeconds() - cpu);
         const FaceGraph g = buildFaceGraph(mesh);
         size_t differLabels = 0, differCells = 0;
         for (size_t f = 0; f < mesh.triangles.size(); ++f) {
@@ -172,16 +188,20 @@ int main(int argc, char** argv) {
         const auto sa = seamFaces(g, r.facePieces), sb = seamFaces(g, rf.facePieces);
         const auto [mean1, max1] = seamDistance(g, sa, sb);
         const auto [mean2, max2] = seamDistance(g, sb, sa);
-        std::printf("default vs finer: graph-cut labels differ on %.2f%% of faces, final cell balls on %.2f%%; "
-                    "final seams: default -> finer mean %.2f mm max %.2f mm, finer -> default mean %.2f mm max %.2f mm\n",
-                    100.0 * double(differLabels) / double(mesh.triangles.size()),
-                    100.0 * double(differCells) / double(mesh.triangles.size()), mean1, max1, mean2, max2);
+        std::printf(
+            "default vs finer: graph-cut labels differ on %.2f%% of faces, final cell balls on %.2f%%; "
+            "final seams: default -> finer mean %.2f mm max %.2f mm, finer -> default mean %.2f mm max %.2f "
+            "mm\n",
+            100.0 * double(differLabels) / double(mesh.triangles.size()),
+            100.0 * double(differCells) / double(mesh.triangles.size()), mean1, max1, mean2, max2);
     };
     if (mode == "bunny" || mode == "all") {
         const double cpu = cpuSeconds();
         const Stopwatch w;
-        const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, Fabrication{}, o, RunContext::silent());
-        report("bunny_cgal_75k at 400 mm, printer 200 mm^3", bunny.mesh, frame.outermost, r, w.seconds(), cpuSeconds() - cpu);
+        const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost,
+                                                   Fabrication{}, o, RunContext::silent());
+        report("bunny_cgal_75k at 400 mm, printer 200 mm^3", bunny.mesh, frame.outermost, r, w.seconds(),
+               cpuSeconds() - cpu);
     }
     if (mode == "compare") compare("bunny_cgal_75k at 400 mm, printer 200 mm^3", bunny.mesh);
     if (mode == "million" || mode == "compare-million" || mode == "all") {
@@ -191,9 +211,10 @@ int main(int argc, char** argv) {
         } else {
             const double cpu = cpuSeconds();
             const Stopwatch w;
-            const PartitionResult r = partitionSurface(fine, frame.structure, frame.outermost, Fabrication{}, o, RunContext::silent());
-            report("bunny_cgal_75k subdivided twice (1-to-4 midpoint), 400 mm", fine, frame.outermost, r, w.seconds(),
-                   cpuSeconds() - cpu);
+            const PartitionResult r = partitionSurface(fine, frame.structure, frame.outermost, Fabrication{},
+                                                       o, RunContext::silent());
+            report("bunny_cgal_75k subdivided twice (1-to-4 midpoint), 400 mm", fine, frame.outermost, r,
+                   w.seconds(), cpuSeconds() - cpu);
         }
     }
     return 0;

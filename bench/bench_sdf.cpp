@@ -122,7 +122,7 @@ void runSteps(const Args& args) {
 
     sdf::ObjectFieldOptions objectOptions;
     objectOptions.voxelMm = args.voxelMm;
-        objectOptions.fieldVoxelMm = args.fieldVoxelMm;
+    objectOptions.fieldVoxelMm = args.fieldVoxelMm;
     clock = StepClock();
     sdf::MeshToLevelSetOptions objectLevelSet;
     objectLevelSet.voxelMm = objectOptions.voxelMm;
@@ -185,8 +185,8 @@ void runSteps(const Args& args) {
     std::printf("step                          wall s   CPU s\n");
     std::printf("read+validate+scale          %6.2f  %6.2f\n", readSeconds, readCpu);
     std::printf("object (%g mm, %g mm deep)   %6.2f  %6.2f  %10zu active voxels  %7.1f MB\n",
-                object.info().voxelMm, args.shellMm, objectSeconds, objectCpu,
-                object.activeVoxelCount(), megabytes(object.memoryBytes()));
+                object.info().voxelMm, args.shellMm, objectSeconds, objectCpu, object.activeVoxelCount(),
+                megabytes(object.memoryBytes()));
     std::printf("interior (%g mm, whole)      %6.2f  %6.2f  %10zu active voxels  %7.1f MB\n",
                 interior.info().voxelMm, interiorSeconds, interiorCpu, interior.activeVoxelCount(),
                 megabytes(interior.memoryBytes()));

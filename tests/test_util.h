@@ -9,7 +9,6 @@
 #include <string>
 
 #include "zomefab/core/error.h"
-
 #include "zomefab/core/tri_mesh.h"
 
 namespace zomefab::test {

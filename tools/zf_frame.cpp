@@ -37,12 +37,14 @@ int main(int argc, char** argv) {
 
         const frame::FrameResult result = frame::buildFrame(field, fabrication, o, context);
         const frame::FrameField ff(field, result.rotationDeg, result.lattice.structure.scale(), result.zone);
-        const frame::FrameMetrics before = frame::measureFrame(result.lattice.structure, ff, o.surfaceSampleSpacingMm);
+        const frame::FrameMetrics before =
+            frame::measureFrame(result.lattice.structure, ff, o.surfaceSampleSpacingMm);
         const frame::FrameMetrics after = frame::measureFrame(result.structure, ff, o.surfaceSampleSpacingMm);
         report = frame::frameReportJson(result, o, before, after);
         report["input"] = input;
         report["output"] = output;
-        const Transform4d transformMm = frame::frameTransformMm(levelSet.info().transformMm, result.rotationDeg);
+        const Transform4d transformMm =
+            frame::frameTransformMm(levelSet.info().transformMm, result.rotationDeg);
         const nlohmann::json frameJson = zome::structureToJson(result.structure, transformMm);
         writeOutputAtomic(output, [&](std::ostream& out) { out << frameJson.dump(1) << '\n'; });
 

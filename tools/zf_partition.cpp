@@ -20,15 +20,19 @@ using namespace zomefab;
 using nlohmann::json;
 
 int main(int argc, char** argv) {
-    cli::Tool tool("zf-partition",
-                   "Partition the surface into printable pieces over the frame's outermost balls (paper §5): graph "
-                   "cut, fit schedule, planar cuts from a multi-class linear SVM.");
+    cli::Tool tool(
+        "zf-partition",
+        "Partition the surface into printable pieces over the frame's outermost balls (paper §5): graph "
+        "cut, fit schedule, planar cuts from a multi-class linear SVM.");
     std::string meshPath, framePath, output, coloredPly, colorBy = "pieces", inFormat;
     cli::FabricationCli fabricationCli;
     cli::PartitionCli partitionCli;
     auto& app = tool.app();
-    app.add_option("mesh", meshPath, "Surface mesh (.stl .obj .ply .gltf .glb) in its own coordinates")->required();
-    app.add_option("frame", framePath, "Frame file (zomefab.structure JSON); its transform_mm places the mesh")->required();
+    app.add_option("mesh", meshPath, "Surface mesh (.stl .obj .ply .gltf .glb) in its own coordinates")
+        ->required();
+    app.add_option("frame", framePath,
+                   "Frame file (zomefab.structure JSON); its transform_mm places the mesh")
+        ->required();
     app.add_option("-o,--output", output, "PARTITION.json (- = stdout)")->required();
     fabricationCli.addTo(app, cli::kPrinter);
     partitionCli.addTo(app);
@@ -36,7 +40,8 @@ int main(int argc, char** argv) {
     app.add_option("--color-by", colorBy, "Groups for --colored-ply")
         ->check(CLI::IsMember({"pieces", "cells", "labels", "nearest"}))
         ->capture_default_str();
-    tool.addFormatOption("--in-format", inFormat, {"stl", "obj", "ply", "gltf", "glb"}, "Mesh format (needed for -)");
+    tool.addFormatOption("--in-format", inFormat, {"stl", "obj", "ply", "gltf", "glb"},
+                         "Mesh format (needed for -)");
 
     return tool.run(argc, argv, [&](json& report) {
         const Fabrication fabrication = fabricationCli.resolve(tool.common().seed);
@@ -58,25 +63,32 @@ int main(int argc, char** argv) {
             // Input problems here are the frame's, or the pair's: name the frame file (and the mesh).
             if (e.code() != ErrorCode::InvalidInput) throw;
             const bool isPair = e.message().rfind("frame and mesh", 0) == 0;
-            throw Error(e.code(), e.message() + (isPair ? " (mesh " + meshPath + ")" : std::string()), framePath);
+            throw Error(e.code(), e.message() + (isPair ? " (mesh " + meshPath + ")" : std::string()),
+                        framePath);
         }
-        const partition::PartitionJsonInfo info{meshPath, std::filesystem::path(framePath).filename().string(), transformMm,
-                                                mesh.positions.size()};
+        const partition::PartitionJsonInfo info{meshPath,
+                                                std::filesystem::path(framePath).filename().string(),
+                                                transformMm, mesh.positions.size()};
         const std::string text = partition::partitionToJson(r, opt, info).dump(1) + "\n";
         writeOutputAtomic(output, [&](std::ostream& out) { out << text; });
         if (!coloredPly.empty()) {
             const std::string bytes = partition::coloredPlyBytes(mesh, partition::faceGroups(r, colorBy));
-            writeOutputAtomic(coloredPly, [&](std::ostream& out) { out.write(bytes.data(), std::streamsize(bytes.size())); });
+            writeOutputAtomic(coloredPly, [&](std::ostream& out) {
+                out.write(bytes.data(), std::streamsize(bytes.size()));
+            });
         }
         report = partition::partitionSummaryJson(r);
-        cli::printInfo(tool, meshPath + ": " + std::to_string(mesh.triangles.size()) + " faces, " +
-                                 std::to_string(labels.size()) + " outermost balls: nearest ball " +
-                                 std::to_string(r.nearestPartitions) + " partitions, graph cut " +
-                                 std::to_string(r.graphCutPartitions) + formatNumbers(" (w_smoothness %g), ", r.smoothnessWeight) +
-                                 std::to_string(r.pieces.size()) + " pieces, all fit " +
-                                 formatNumbers("%gx%gx%g mm", fabrication.printerMm[0], fabrication.printerMm[1],
-                                               fabrication.printerMm[2]) +
-                                 (r.isScheduleBottomedOut ? " (schedule bottomed out: oversized partitions were split)" : ""));
+        cli::printInfo(
+            tool,
+            meshPath + ": " + std::to_string(mesh.triangles.size()) + " faces, " +
+                std::to_string(labels.size()) + " outermost balls: nearest ball " +
+                std::to_string(r.nearestPartitions) + " partitions, graph cut " +
+                std::to_string(r.graphCutPartitions) +
+                formatNumbers(" (w_smoothness %g), ", r.smoothnessWeight) + std::to_string(r.pieces.size()) +
+                " pieces, all fit " +
+                formatNumbers("%gx%gx%g mm", fabrication.printerMm[0], fabrication.printerMm[1],
+                              fabrication.printerMm[2]) +
+                (r.isScheduleBottomedOut ? " (schedule bottomed out: oversized partitions were split)" : ""));
         return 0;
     });
 }

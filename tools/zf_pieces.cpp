@@ -19,7 +19,8 @@ namespace fs = std::filesystem;
 namespace {
 
 /// The shell grid: --grid, else the one named "shell", else the first.
-const sdf::LevelSet& shellGrid(const std::vector<sdf::LevelSet>& grids, std::string name, const std::string& path) {
+const sdf::LevelSet& shellGrid(const std::vector<sdf::LevelSet>& grids, std::string name,
+                               const std::string& path) {
     if (name.empty())
         for (const sdf::LevelSet& g : grids)
             if (g.info().name == "shell") name = "shell";
@@ -36,7 +37,8 @@ pieces::Pieces cut(const sdf::LevelSet& shell, const zome::Structure& frame, con
     } catch (const Error& e) {
         if (e.code() == ErrorCode::InvalidInput && e.message().find("frame") != std::string::npos)
             throw Error(e.code(), paths[0] + " and " + paths[1] + ": " + e.message(), paths[1]);
-        if (e.code() == ErrorCode::InvalidInput || e.code() == ErrorCode::ProcessingFailed) throw e.withFile(paths[2]);
+        if (e.code() == ErrorCode::InvalidInput || e.code() == ErrorCode::ProcessingFailed)
+            throw e.withFile(paths[2]);
         throw;
     }
 }
@@ -44,9 +46,10 @@ pieces::Pieces cut(const sdf::LevelSet& shell, const zome::Structure& frame, con
 }  // namespace
 
 int main(int argc, char** argv) {
-    cli::Tool tool("zf-pieces",
-                   "Cut the shell into printable pieces along the partition's cells, grow tenons into the frame's "
-                   "free blue holes, engrave piece numbers, orient each piece for the printer (paper §6).");
+    cli::Tool tool(
+        "zf-pieces",
+        "Cut the shell into printable pieces along the partition's cells, grow tenons into the frame's "
+        "free blue holes, engrave piece numbers, orient each piece for the printer (paper §6).");
     std::string shellPath, framePath, partitionPath, output, gridName;
     cli::FabricationCli fabricationCli;
     cli::PiecesCli piecesCli;
@@ -54,14 +57,16 @@ int main(int argc, char** argv) {
     app.add_option("shell", shellPath, "SHELL.vdb from zf-shell (- reads stdin)")->required();
     app.add_option("frame", framePath, "FRAME.json from zf-frame")->required();
     app.add_option("partition", partitionPath, "PARTITION.json from zf-partition")->required();
-    app.add_option("-o,--output", output, "Output directory (piece-NN.stl, pieces.3mf, pieces.json)")->required();
+    app.add_option("-o,--output", output, "Output directory (piece-NN.stl, pieces.3mf, pieces.json)")
+        ->required();
     app.add_option("--grid", gridName, "Level set to cut (default: \"shell\" if present, else the first)");
     fabricationCli.addTo(app, cli::kPrinter);
     piecesCli.addTo(app);
 
     return tool.run(argc, argv, [&](json& report) {
         Fabrication fabrication = fabricationCli.resolve(tool.common().seed);
-        const pieces::PiecesOptions options = piecesCli.resolve();  // bad options fail before any input is read
+        const pieces::PiecesOptions options =
+            piecesCli.resolve();  // bad options fail before any input is read
         RunContext& context = tool.context();
         const std::vector<sdf::LevelSet> grids = sdf::parseVdb(readInputBytes(shellPath), shellPath, context);
         const sdf::LevelSet& shell = shellGrid(grids, gridName, shellPath);
@@ -69,9 +74,11 @@ int main(int argc, char** argv) {
         const zome::Structure frame = cli::readFrame(framePath, &frameTransform);
         const partition::PartitionFile partition = cli::readPartition(partitionPath);
         if (!isNearlyEqual(partition.info.transformMm, frameTransform))
-            throw Error(ErrorCode::InvalidInput, "was made with another frame: its transform_mm differs from " + framePath + "'s",
+            throw Error(ErrorCode::InvalidInput,
+                        "was made with another frame: its transform_mm differs from " + framePath + "'s",
                         partitionPath);
-        if (fabricationCli.printer.empty()) fabrication.printerMm = partition.result.printerMm;  // the partition's printer
+        if (fabricationCli.printer.empty())
+            fabrication.printerMm = partition.result.printerMm;  // the partition's printer
         const Transform4d frameToGrid = [&] {
             try {
                 return shell.info().transformMm * affineInverse(frameTransform);
@@ -79,18 +86,19 @@ int main(int argc, char** argv) {
                 throw e.withFile(framePath);
             }
         }();
-        const pieces::Pieces result = cut(shell, frame, frameToGrid, partition.result, fabrication, options, context,
-                                          {shellPath, framePath, partitionPath});
+        const pieces::Pieces result = cut(shell, frame, frameToGrid, partition.result, fabrication, options,
+                                          context, {shellPath, framePath, partitionPath});
         pieces::writePieces(result, output,
                             {shell.info().sourceFile, fs::path(framePath).filename().string(),
                              fs::path(partitionPath).filename().string()});
         report = pieces::piecesToJson(result, {})["summary"];
         report["output"] = output;
         report["peak_rss_bytes"] = peakRssBytes();
-        cli::printInfo(tool, std::to_string(result.pieces.size()) + " pieces, " + report["tenons"].dump() + " tenons (" +
-                                 report["pieces_with_few_tenons"].dump() + " pieces with fewer than " +
-                                 std::to_string(options.tenons.minPerPiece) + "), " + report["labelled"].dump() +
-                                 " numbered" + formatNumbers("; %.1f s", result.seconds));
+        cli::printInfo(tool, std::to_string(result.pieces.size()) + " pieces, " + report["tenons"].dump() +
+                                 " tenons (" + report["pieces_with_few_tenons"].dump() +
+                                 " pieces with fewer than " + std::to_string(options.tenons.minPerPiece) +
+                                 "), " + report["labelled"].dump() + " numbered" +
+                                 formatNumbers("; %.1f s", result.seconds));
         return 0;
     });
 }

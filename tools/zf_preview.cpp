@@ -22,18 +22,22 @@ namespace fs = std::filesystem;
 namespace {
 
 /// A directory of meshes already in frame mm (no pieces.json): one piece per file, sorted.
-void readMeshDirectory(const std::string& path, std::vector<TriMesh>& meshes, std::vector<std::string>& names) {
+void readMeshDirectory(const std::string& path, std::vector<TriMesh>& meshes,
+                       std::vector<std::string>& names) {
     std::error_code ec;
     std::vector<fs::path> files;
     for (const fs::directory_entry& e : fs::directory_iterator(path, ec)) {
         const std::string ext = fileExtension(e.path().string());
-        if (e.is_regular_file() && (ext == "stl" || ext == "obj" || ext == "ply" || ext == "glb" || ext == "gltf"))
+        if (e.is_regular_file() &&
+            (ext == "stl" || ext == "obj" || ext == "ply" || ext == "glb" || ext == "gltf"))
             files.push_back(e.path());
     }
     if (ec) throw Error(ErrorCode::InvalidInput, "cannot list the directory: " + ec.message(), path);
-    if (files.empty()) throw Error(ErrorCode::InvalidInput, "no pieces.json and no mesh files in the directory", path);
+    if (files.empty())
+        throw Error(ErrorCode::InvalidInput, "no pieces.json and no mesh files in the directory", path);
     std::sort(files.begin(), files.end());
-    for (const fs::path& f : files) meshes.push_back(readMesh(f.string())), names.push_back(f.stem().string());
+    for (const fs::path& f : files)
+        meshes.push_back(readMesh(f.string())), names.push_back(f.stem().string());
 }
 
 }  // namespace
@@ -47,7 +51,8 @@ int main(int argc, char** argv) {
     app.add_option("frame", framePath, "Frame file (zomefab.structure JSON, - = stdin)")->required();
     app.add_option("--pieces", piecesPath,
                    "pieces.json of zf-pieces, a directory holding one, or a directory of meshes in frame mm");
-    app.add_option("--object", objectPath, "The input mesh, to name it and its size in the scene (with --height-mm, --up)");
+    app.add_option("--object", objectPath,
+                   "The input mesh, to name it and its size in the scene (with --height-mm, --up)");
     app.add_option("-o,--output", output, "Output .glb (- = stdout)")->required();
     scaleCli.addTo(app);
     previewCli.addTo(app);
@@ -61,7 +66,8 @@ int main(int argc, char** argv) {
         pieces::Pieces pieces;
         std::vector<TriMesh> meshes;
         std::error_code ec;
-        if (!piecesPath.empty() && (!fs::is_directory(piecesPath, ec) || fs::exists(fs::path(piecesPath) / pieces::kPiecesFile))) {
+        if (!piecesPath.empty() &&
+            (!fs::is_directory(piecesPath, ec) || fs::exists(fs::path(piecesPath) / pieces::kPiecesFile))) {
             pieces = pieces::readPieces(piecesPath);
             input = report::previewInput(pieces, frame);
         } else if (!piecesPath.empty()) {
@@ -72,16 +78,20 @@ int main(int argc, char** argv) {
         if (!objectPath.empty())
             input.extras = report::previewExtras(
                 objectPath,
-                mesh::scaleToMillimetres(mesh::validateClosedMesh(readMesh(objectPath), {}, objectPath, tool.context()), scale)
+                mesh::scaleToMillimetres(
+                    mesh::validateClosedMesh(readMesh(objectPath), {}, objectPath, tool.context()), scale)
                     .sizeMm);
         const std::string glb = serializeGlb(report::buildPreviewScene(input, options), options.glb);
-        writeOutputAtomic(output, [&](std::ostream& out) { out.write(glb.data(), std::streamsize(glb.size())); });
+        writeOutputAtomic(output,
+                          [&](std::ostream& out) { out.write(glb.data(), std::streamsize(glb.size())); });
 
-        report = {{"frame", framePath}, {"pieces", input.pieces.size()}, {"balls", frame.ballCount()},
-                  {"struts", frame.strutCount()}, {"output", output}, {"bytes", glb.size()}};
+        report = {{"frame", framePath},         {"pieces", input.pieces.size()},
+                  {"balls", frame.ballCount()}, {"struts", frame.strutCount()},
+                  {"output", output},           {"bytes", glb.size()}};
         cli::printInfo(tool, framePath + ": " + std::to_string(frame.ballCount()) + " balls, " +
-                                 std::to_string(frame.strutCount()) + " struts, " + std::to_string(input.pieces.size()) +
-                                 " pieces -> " + output + formatNumbers(" (%.1f kB)", double(glb.size()) / 1000.0));
+                                 std::to_string(frame.strutCount()) + " struts, " +
+                                 std::to_string(input.pieces.size()) + " pieces -> " + output +
+                                 formatNumbers(" (%.1f kB)", double(glb.size()) / 1000.0));
         return 0;
     });
 }

@@ -14,7 +14,8 @@
 using namespace zomefab;
 
 int main(int argc, char** argv) {
-    cli::Tool tool("zf-report", "Write the assembly guide and the cost report of a frame and its printed pieces");
+    cli::Tool tool("zf-report",
+                   "Write the assembly guide and the cost report of a frame and its printed pieces");
     CLI::App& app = tool.app();
     std::string meshPath, framePath, piecesPath, outDir;
     cli::ScaleCli scaleCli;
@@ -22,8 +23,10 @@ int main(int argc, char** argv) {
     cli::CostCli costCli;
     app.add_option("mesh", meshPath, "The object's mesh, as given to zf-sdf")->required();
     app.add_option("frame", framePath, "FRAME.json from zf-frame")->required();
-    app.add_option("pieces", piecesPath, "The pieces directory (or its pieces.json) from zf-pieces")->required();
-    app.add_option("-o,--output", outDir, "Directory to write assembly.md and cost.md into (must exist)")->required();
+    app.add_option("pieces", piecesPath, "The pieces directory (or its pieces.json) from zf-pieces")
+        ->required();
+    app.add_option("-o,--output", outDir, "Directory to write assembly.md and cost.md into (must exist)")
+        ->required();
     scaleCli.addTo(app);
     fabricationCli.addTo(app, cli::kPrinter);
     costCli.addTo(app);
@@ -35,16 +38,19 @@ int main(int argc, char** argv) {
         RunContext& context = tool.context();
         report::RunRecord run;
         run.sourceName = meshPath;
-        run.scaled = mesh::scaleToMillimetres(mesh::validateClosedMesh(readMesh(meshPath), {}, meshPath, context), scale);
+        run.scaled = mesh::scaleToMillimetres(
+            mesh::validateClosedMesh(readMesh(meshPath), {}, meshPath, context), scale);
         run.frame.structure = cli::readFrame(framePath);
         run.pieces = pieces::readPieces(piecesPath);
-        if (fabricationCli.printer.empty()) fabrication.printerMm = run.pieces.printerMm;  // the pieces' printer
-        report::RunReports reports =
-            report::reportStage(run.frame.structure, run.pieces, run.scaled.mesh, fabrication, costOptions, context);
+        if (fabricationCli.printer.empty())
+            fabrication.printerMm = run.pieces.printerMm;  // the pieces' printer
+        report::RunReports reports = report::reportStage(run.frame.structure, run.pieces, run.scaled.mesh,
+                                                         fabrication, costOptions, context);
         run.assembly = std::move(reports.assembly);
         run.cost = std::move(reports.cost);
-        writeOutputAtomic(outDir + "/assembly.md",
-                          [&](std::ostream& out) { out << report::assemblyGuideMarkdown(run.assembly, costOptions.prices); });
+        writeOutputAtomic(outDir + "/assembly.md", [&](std::ostream& out) {
+            out << report::assemblyGuideMarkdown(run.assembly, costOptions.prices);
+        });
         writeOutputAtomic(outDir + "/cost.md", [&](std::ostream& out) { out << report::costPage(run); });
         report = report::costReportToJson(run.cost);
         for (const std::string& line : report::runSummaryLines(run)) cli::printInfo(tool, line);

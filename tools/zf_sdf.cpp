@@ -35,7 +35,8 @@ int main(int argc, char** argv) {
     fieldCli.addTo(app);
 
     return tool.run(argc, argv, [&](json& report) {
-        const mesh::ScaleOptions scaleOptions = scaleCli.resolve();  // bad options fail before any input is read
+        const mesh::ScaleOptions scaleOptions =
+            scaleCli.resolve();  // bad options fail before any input is read
         const Fabrication fabrication = fabricationCli.resolve(tool.common().seed);
         sdf::checkObjectFieldOptions(fieldCli.options);
         MeshReadOptions readOptions;

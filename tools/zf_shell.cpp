@@ -25,7 +25,8 @@ int main(int argc, char** argv) {
     app.add_option("--grid", gridName, "Which level set of the input to hollow")->capture_default_str();
 
     return tool.run(argc, argv, [&](json& report) {
-        const Fabrication fabrication = fabricationCli.resolve(tool.common().seed);  // fails before any input is read
+        const Fabrication fabrication =
+            fabricationCli.resolve(tool.common().seed);  // fails before any input is read
         RunContext& context = tool.context();
         Stopwatch clock;
         const std::vector<sdf::LevelSet> grids = sdf::parseVdb(readInputBytes(input), input, context);

@@ -6,44 +6,13 @@
 #include <vector>
 
 #include "common/cli.h"
+#include "common/stage_options.h"
 #include "zomefab/core/error.h"
 #include "zomefab/io/file_io.h"
 #include "zomefab/zome/parts.h"
 #include "zomefab/zome/structure_json.h"
 
 using namespace zomefab;
-
-namespace {
-
-zome::Structure readFrame(const std::string& path, const zome::ZomeScale& physical,
-                          const zome::CollisionOptions& collision) {
-    const std::string bytes = readInputBytes(path);
-    try {
-        return zome::structureFromJsonText(bytes, physical, collision);
-    } catch (const Error& e) {
-        throw e.withFile(path);
-    }
-}
-
-nlohmann::json collisionJson(const zome::Collision& c) {
-    return {{"kind", zome::collisionKindName(c.kind)},
-            {"first", c.first},
-            {"second", c.second},
-            {"distance_mm", c.distanceMm},
-            {"limit_mm", c.limitMm}};
-}
-
-std::string describe(const zome::Collision& c) {
-    const bool strutFirst = c.kind != zome::CollisionKind::BallBall;
-    const bool strutSecond = c.kind == zome::CollisionKind::StrutStrut;
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "%s %u and %s %u (%s, %.2f mm < %.2f mm)", strutFirst ? "strut" : "ball",
-                  c.first, strutSecond ? "strut" : "ball", c.second, zome::collisionKindName(c.kind),
-                  c.distanceMm, c.limitMm);
-    return buf;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
     cli::Tool tool("zf-zome", "Check a Zometool frame file, export it to vZome VEF, or list its parts");
@@ -89,7 +58,7 @@ int main(int argc, char** argv) {
 
     return tool.run(argc, argv, [&](nlohmann::json& report) {
         const Stopwatch clock;
-        const zome::Structure frame = readFrame(input, physical, collision);
+        const zome::Structure frame = cli::readFrame(input, nullptr, physical, collision);
         report["input"] = input;
         report["balls"] = frame.ballCount();
         report["struts"] = frame.strutCount();
@@ -99,23 +68,7 @@ int main(int argc, char** argv) {
         if (check->parsed()) {
             const std::vector<zome::Collision> collisions = zome::findCollisions(frame);
             const zome::PartsList list = zome::partsList(frame);
-            nlohmann::json out = {{"file", input},
-                                  {"valid", true},
-                                  {"balls", frame.ballCount()},
-                                  {"struts", frame.strutCount()},
-                                  {"collision_free", collisions.empty()},
-                                  {"collision_count", collisions.size()},
-                                  {"collisions", nlohmann::json::array()},
-                                  {"parts", zome::partsListToJson(list, prices)},
-                                  {"scale",
-                                   {{"b0_mm", frame.scale().b0Mm},
-                                    {"unit_mm", frame.scale().unitMm()},
-                                    {"ball_diameter_mm", frame.scale().ballDiameterMm},
-                                    {"blue_radius_mm", frame.scale().blueRadiusMm},
-                                    {"yellow_radius_mm", frame.scale().yellowRadiusMm},
-                                    {"red_radius_mm", frame.scale().redRadiusMm},
-                                    {"clearance_mm", collision.clearanceMm}}}};
-            for (const zome::Collision& c : collisions) out["collisions"].push_back(collisionJson(c));
+            const nlohmann::json out = zome::checkReportJson(frame, input, collisions, prices);
             cli::writeJsonFile(out, output);
             report["collisions"] = collisions.size();
             report["seconds"] = clock.seconds();
@@ -123,7 +76,7 @@ int main(int argc, char** argv) {
                 // The report is written (it lists every pair); the exit code says "not buildable".
                 std::fprintf(stderr, "zf-zome: error: %s: %zu collision%s, first: %s\n", input.c_str(),
                              collisions.size(), collisions.size() == 1 ? "" : "s",
-                             describe(collisions.front()).c_str());
+                             zome::describeCollision(collisions.front()).c_str());
                 return exitCodeFor(ErrorCode::ProcessingFailed);
             }
             char cost[64];

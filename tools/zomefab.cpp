@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <iostream>
 
+#include "common/batch_cli.h"
 #include "common/cli.h"
 #include "common/run_options.h"
-#include "zomefab/batch/batch.h"
 #include "zomefab/core/error.h"
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/report/run_report.h"
@@ -34,82 +34,6 @@ int runCommand(cli::Tool& tool, const cli::RunCli& cli, json& report) {
     return 0;
 }
 
-/// What workers inherit from this process: the seed, the thread limit, -q.
-batch::WorkerCommand workerCommand(const cli::Tool& tool) {
-    batch::WorkerCommand command{"/proc/self/exe", {"--seed", std::to_string(tool.common().seed)}};
-    if (tool.common().threads > 0) command.sharedArgs.insert(command.sharedArgs.end(), {"--threads", std::to_string(tool.common().threads)});
-    if (tool.common().verbosity < 0) command.sharedArgs.push_back("-q");
-    return command;
-}
-
-struct BatchCli {
-    std::string manifest, outDir;
-    int index = -1;
-    bool isMergeOnly = false;
-
-    void addTo(CLI::App& app) {
-        app.add_option("manifest", manifest, "Batch manifest (docs/batch.md)")->required();
-        app.add_option("-o,--output", outDir, "Directory for one output directory per entry and the summary")->required();
-        app.add_option("--index", index, "Run entry I alone (for Slurm job arrays or GNU parallel)")->check(CLI::NonNegativeNumber);
-        app.add_flag("--merge", isMergeOnly, "Only join the per-entry summaries already in the output directory");
-    }
-
-    int execute(cli::Tool& tool, json& report) const {
-        const std::vector<batch::BatchEntry> entries = batch::readManifest(manifest);
-        for (size_t i = 0; i < entries.size(); ++i) {
-            try {
-                cli::checkRunArguments(entries[i].runArgs);
-            } catch (const Error& e) {
-                throw Error(ErrorCode::InvalidInput, "entry " + std::to_string(i) + ": " + e.message(), manifest);
-            }
-        }
-        std::error_code ec;
-        std::filesystem::create_directories(outDir, ec);
-        if (!std::filesystem::is_directory(outDir)) throw Error(ErrorCode::WriteFailed, "cannot create the directory", outDir);
-        if (index >= 0) {
-            if (size_t(index) >= entries.size())
-                throw Error(ErrorCode::Usage, "--index " + std::to_string(index) + " is past the last entry (" +
-                                                  std::to_string(entries.size() - 1) + ")");
-            report = batch::runEntry(workerCommand(tool), entries, size_t(index), outDir, tool.context());
-            return report["exit_code"] == 0 ? 0 : 3;
-        }
-        if (!isMergeOnly)
-            for (size_t i = 0; i < entries.size(); ++i)
-                if (batch::runEntry(workerCommand(tool), entries, i, outDir, tool.context())["exit_code"] == 5)
-                    throw Error(ErrorCode::Cancelled, "interrupted");
-        report = batch::mergeSummaries(entries, outDir);
-        std::cerr << batch::summaryTable(report["entries"]);
-        size_t failed = 0;
-        for (const json& r : report["entries"]) failed += r["status"] != "ok";
-        cli::printInfo(tool, std::to_string(entries.size() - failed) + " of " + std::to_string(entries.size()) +
-                                 " inputs succeeded; summary in " + outDir + "/summary.md");
-        return failed == 0 ? 0 : 3;
-    }
-};
-
-struct BenchCli {
-    std::string output = "-";
-    batch::BenchOptions options;
-
-    void addTo(CLI::App& app) {
-        app.add_option("-o,--output", output, "Benchmark JSON (- = stdout)")->capture_default_str();
-        app.add_option("--mesh", options.meshes, "Meshes under --data-dir to run (repeatable)")->capture_default_str();
-        app.add_option("--height-mm", options.heightsMm, "Object heights to run each mesh at (repeatable)")->capture_default_str();
-        app.add_option("--up", options.up, "Up axis of the meshes")->capture_default_str();
-        app.add_option("--data-dir", options.dataDir, "Where the meshes are")->capture_default_str();
-        app.add_option("--run-arg", options.extraArgs, "Extra option passed to every `zomefab run` (repeatable)");
-    }
-
-    int execute(cli::Tool& tool, json& report) const {
-        report = batch::runBench(workerCommand(tool), options, tool.context());
-        report["threads"] = tool.common().threads;
-        cli::writeJsonFile(report, output);
-        for (const json& c : report["cases"])
-            if (c["exit_code"] != 0) return 3;
-        return 0;
-    }
-};
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -117,11 +41,13 @@ int main(int argc, char** argv) {
     CLI::App& app = tool.app();
     app.require_subcommand(1);
     cli::RunCli runCli;
-    BatchCli batchCli;
-    BenchCli benchCli;
-    CLI::App* run = app.add_subcommand("run", "Run every stage on one mesh and write the outputs into a directory");
+    cli::BatchCli batchCli;
+    cli::BenchCli benchCli;
+    CLI::App* run =
+        app.add_subcommand("run", "Run every stage on one mesh and write the outputs into a directory");
     CLI::App* batch = app.add_subcommand("batch", "Run many inputs from a manifest, one worker process each");
-    CLI::App* bench = app.add_subcommand("bench", "Time every stage on bundled meshes at several sizes; JSON out");
+    CLI::App* bench =
+        app.add_subcommand("bench", "Time every stage on bundled meshes at several sizes; JSON out");
     for (CLI::App* sub : {run, batch, bench}) sub->fallthrough();
     runCli.addTo(*run);
     batchCli.addTo(*batch);

@@ -51,8 +51,8 @@ TEST_CASE("anneal: every accepted move keeps the frame valid and ΔE exact") {
         const double full = frame::frameEnergy(move.structure, ff, energy).total;
         if (std::abs(full - move.energy) > 1e-9 * std::max(1.0, std::abs(full))) ++mismatches;
     };
-    const frame::ChainResult r = frame::annealChain(lattice.structure, ff, energy, o.anneal, 99, 0,
-                                                    RunContext::silent());
+    const frame::ChainResult r =
+        frame::annealChain(lattice.structure, ff, energy, o.anneal, 99, 0, RunContext::silent());
     CHECK(checked > 1000);  // thousands of moves were checked
     CHECK(checked == r.stats.accepted);
     CHECK(problems == 0);
@@ -78,7 +78,8 @@ TEST_CASE("anneal: a 300 mm sphere's outermost balls end within [dMin, dMax] of 
     const std::vector<zome::BallId> out = frame::outermostBalls(r.structure);
     REQUIRE(!out.empty());
     for (zome::BallId id : out) {
-        const double clearance = ff.depthMm(r.structure.ball(id).positionMm) - r.structure.scale().ballRadiusMm();
+        const double clearance =
+            ff.depthMm(r.structure.ball(id).positionMm) - r.structure.scale().ballRadiusMm();
         INFO("ball " << id << " clearance " << clearance);
         CHECK(clearance >= o.lattice.zone.dMinMm);
         CHECK(clearance <= o.lattice.zone.dMaxMm);

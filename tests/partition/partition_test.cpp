@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include "zomefab/partition/partition.h"
+
 #include <doctest/doctest.h>
 #include <tbb/global_control.h>
 
@@ -12,7 +14,6 @@
 #include "zomefab/core/error.h"
 #include "zomefab/partition/alpha_expansion.h"
 #include "zomefab/partition/face_graph.h"
-#include "zomefab/partition/partition.h"
 #include "zomefab/partition/partition_json.h"
 
 using namespace zomefab;
@@ -24,7 +25,8 @@ namespace {
 zome::Structure ballsAt(const std::vector<std::array<int, 3>>& points) {
     zome::Structure s;
     for (const auto& p : points)
-        s.addBall({zome::Golden{2 * p[0], 2 * p[0]}, zome::Golden{2 * p[1], 2 * p[1]}, zome::Golden{2 * p[2], 2 * p[2]}});
+        s.addBall({zome::Golden{2 * p[0], 2 * p[0]}, zome::Golden{2 * p[1], 2 * p[1]},
+                   zome::Golden{2 * p[2], 2 * p[2]}});
     return s;
 }
 
@@ -68,7 +70,8 @@ void checkResult(const TriMesh& mesh, const PartitionResult& r) {
             const Vec3d& ax = fit.axes[size_t(a)];
             const double c = ax[0] * fit.centerMm[0] + ax[1] * fit.centerMm[1] + ax[2] * fit.centerMm[2];
             double worst = 0.0;
-            for (const Vec3d& q : pts[p]) worst = std::max(worst, std::abs(ax[0] * q[0] + ax[1] * q[1] + ax[2] * q[2] - c));
+            for (const Vec3d& q : pts[p])
+                worst = std::max(worst, std::abs(ax[0] * q[0] + ax[1] * q[1] + ax[2] * q[2] - c));
             CHECK(worst <= 0.5 * fit.extentsMm[size_t(a)] - r.fitMarginMm + 1e-6);
         }
     }
@@ -84,7 +87,8 @@ bool isKeptWhole(const TriMesh& mesh, const PartitionResult& r, const std::vecto
     for (size_t f = 0; f < salient.size(); ++f)
         if (salient[f])
             for (uint32_t v : mesh.triangles[f])
-                if (!std::binary_search(cells.begin(), cells.end(), r.cells.cellAt(toD(mesh.positions[v])))) return false;
+                if (!std::binary_search(cells.begin(), cells.end(), r.cells.cellAt(toD(mesh.positions[v]))))
+                    return false;
     return true;
 }
 
@@ -147,7 +151,8 @@ TEST_CASE("partition: a salient belt across the natural seam is never cut") {
     // A sphere of saliency where the seam would cross the top.
     PartitionOptions bySphere = o;
     bySphere.salientSpheres.push_back({{0, 0, 100}, 30.0});
-    const PartitionResult capped = partitionSurface(sphere, frame, {0, 1}, fab, bySphere, RunContext::silent());
+    const PartitionResult capped =
+        partitionSurface(sphere, frame, {0, 1}, fab, bySphere, RunContext::silent());
     checkResult(sphere, capped);
     const std::vector<uint8_t> cap = salientFaceFlags(sphere, bySphere.salientSpheres, {});
     CHECK(std::count(cap.begin(), cap.end(), uint8_t(1)) > 20);
@@ -157,13 +162,15 @@ TEST_CASE("partition: a salient belt across the natural seam is never cut") {
 }
 
 TEST_CASE("partition: small bunny, energies, pieces, determinism across thread counts") {
-    const partition::test::MeshMm bunny = partition::test::loadMeshMm(zomefab::test::dataPath("bunny_npm_3674.stl"), 300.0, true);
+    const partition::test::MeshMm bunny =
+        partition::test::loadMeshMm(zomefab::test::dataPath("bunny_npm_3674.stl"), 300.0, true);
     const partition::test::LatticeFrame frame = partition::test::makeLatticeFrame(bunny.mesh, 12.0);
     REQUIRE(frame.outermost.size() >= 8);
     PartitionOptions o;
     Fabrication fab;
     fab.printerMm = {120, 120, 120};  // forces several pieces on a 300 mm bunny
-    const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent());
+    const PartitionResult r =
+        partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent());
     checkResult(bunny.mesh, r);
     CHECK(r.graphCutPartitions < r.nearestPartitions);
     CHECK(r.energyGraphCut < r.energyNearest);
@@ -181,7 +188,8 @@ TEST_CASE("partition: small bunny, energies, pieces, determinism across thread c
         for (int i = 0; i < 20000; ++i) {
             Vec3d x;
             for (int a = 0; a < 3; ++a)
-                x[size_t(a)] = std::uniform_real_distribution<double>(box.min[size_t(a)], box.max[size_t(a)])(rng);
+                x[size_t(a)] =
+                    std::uniform_real_distribution<double>(box.min[size_t(a)], box.max[size_t(a)])(rng);
             int winners = 0;
             double best = -1e300;
             for (uint32_t k = 0; k < r.cells.cellCount(); ++k) best = std::max(best, r.cells.score(k, x));
@@ -210,20 +218,28 @@ TEST_CASE("partition: small bunny, energies, pieces, determinism across thread c
     std::string one, two;
     {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-        one = partitionToJson(partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent()), o, info).dump();
+        one = partitionToJson(partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o,
+                                               RunContext::silent()),
+                              o, info)
+                  .dump();
     }
     {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-        two = partitionToJson(partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent()), o, info).dump();
+        two = partitionToJson(partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o,
+                                               RunContext::silent()),
+                              o, info)
+                  .dump();
     }
     CHECK(one == two);
     CHECK(one == partitionToJson(r, o, info).dump());
 }
 
 TEST_CASE("partition: bunny at 400 mm, every piece fits 200 mm cubed") {
-    const partition::test::MeshMm bunny = partition::test::loadMeshMm(zomefab::test::dataPath("bunny_cgal_75k.stl"), 400.0, true);
+    const partition::test::MeshMm bunny =
+        partition::test::loadMeshMm(zomefab::test::dataPath("bunny_cgal_75k.stl"), 400.0, true);
     const partition::test::LatticeFrame frame = partition::test::makeLatticeFrame(bunny.mesh, 12.0);
-    const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, Fabrication{}, {}, RunContext::silent());
+    const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, Fabrication{},
+                                               {}, RunContext::silent());
     checkResult(bunny.mesh, r);
     CHECK(r.printerMm == Vec3d{200, 200, 200});
     CHECK(r.pieces.size() >= 3);  // a 400 mm bunny does not fit a 200 mm printer in fewer
@@ -246,7 +262,8 @@ TEST_CASE("partition: when the schedule bottoms out, oversized partitions are sp
     CHECK(r.pieces.size() >= 4);
     CHECK(r.schedule.back().smoothnessWeight == doctest::Approx(o.smoothnessMin));
     bool isSaid = false;
-    for (const std::string& w : quiet.warnings()) isSaid = isSaid || w.find("bottomed out") != std::string::npos;
+    for (const std::string& w : quiet.warnings())
+        isSaid = isSaid || w.find("bottomed out") != std::string::npos;
     CHECK(isSaid);
     for (const Piece& p : r.pieces) CHECK(p.balls == std::vector<zome::BallId>{0});
 }
@@ -254,8 +271,9 @@ TEST_CASE("partition: when the schedule bottoms out, oversized partitions are sp
 TEST_CASE("partition: bad inputs fail with clear messages") {
     const TriMesh sphere = zomefab::test::makeSphere({0, 0, 0}, 100.0, 16, 32);
     const zome::Structure frame = ballsAt({{-1, 0, 0}, {1, 0, 0}});
-    auto fails = [&](const zome::Structure& s, const std::vector<zome::BallId>& labels, const PartitionOptions& o,
-                     ErrorCode code, const std::string& text, const Fabrication& fab = {}) {
+    auto fails = [&](const zome::Structure& s, const std::vector<zome::BallId>& labels,
+                     const PartitionOptions& o, ErrorCode code, const std::string& text,
+                     const Fabrication& fab = {}) {
         try {
             partitionSurface(sphere, s, labels, fab, o, RunContext::silent());
             FAIL("no error for: " << text);
@@ -281,25 +299,29 @@ TEST_CASE("partition: bad inputs fail with clear messages") {
     noK.candidateCount = 0;
     fails(frame, {0, 1}, noK, ErrorCode::Usage, "k (candidate labels");
     // An empty mesh.
-    CHECK_THROWS_AS(partitionSurface(TriMesh{}, frame, {0, 1}, Fabrication{}, {}, RunContext::silent()), Error);
+    CHECK_THROWS_AS(partitionSurface(TriMesh{}, frame, {0, 1}, Fabrication{}, {}, RunContext::silent()),
+                    Error);
 }
 
 TEST_CASE("partition: partitions that fit at a high w_smoothness are kept while the others are cut again") {
     // The small bunny at 300 mm in a 120 mm printer: the first cut (w_smoothness 10) leaves some
     // partitions that fit and some that do not. Only the latter may be cut again at lower weights;
     // the paper's schedule (every step re-cuts the whole surface) would relabel all of them.
-    const partition::test::MeshMm bunny = partition::test::loadMeshMm(zomefab::test::dataPath("bunny_npm_3674.stl"), 300.0, true);
+    const partition::test::MeshMm bunny =
+        partition::test::loadMeshMm(zomefab::test::dataPath("bunny_npm_3674.stl"), 300.0, true);
     const partition::test::LatticeFrame frame = partition::test::makeLatticeFrame(bunny.mesh, 12.0);
     PartitionOptions o;
     Fabrication fab;
     fab.printerMm = {120, 120, 120};
-    const PartitionResult r = partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent());
+    const PartitionResult r =
+        partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent());
     checkResult(bunny.mesh, r);
 
     // The first step alone: its labelling, and which of its regions fit the printer.
     PartitionOptions firstOnly = o;
     firstOnly.smoothnessMin = o.smoothnessStart;
-    const PartitionResult r10 = partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, firstOnly, RunContext::silent());
+    const PartitionResult r10 =
+        partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, firstOnly, RunContext::silent());
     REQUIRE(r10.schedule.size() == 1);
     const FaceGraph g = buildFaceGraph(bunny.mesh);
     std::vector<uint32_t> compOf;
@@ -336,7 +358,8 @@ TEST_CASE("partition: partitions that fit at a high w_smoothness are kept while 
     // pieces.
     PartitionOptions whole = o;
     whole.refineOversizedOnly = false;
-    const PartitionResult rw = partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, whole, RunContext::silent());
+    const PartitionResult rw =
+        partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, whole, RunContext::silent());
     checkResult(bunny.mesh, rw);
     CHECK(changedFaces(rw) > 0);
     CHECK(r.pieces.size() < rw.pieces.size());

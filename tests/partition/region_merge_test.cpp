@@ -27,15 +27,18 @@ struct Slabs {
     FaceGraph graph = buildFaceGraph(mesh);
     std::vector<uint32_t> regionOf;
     Slabs() {
-        for (const Vec3d& c : graph.centroidsMm) regionOf.push_back(c[2] < -40 ? 0 : c[2] < 0 ? 1 : c[2] < 40 ? 2 : 3);
+        for (const Vec3d& c : graph.centroidsMm)
+            regionOf.push_back(c[2] < -40 ? 0 : c[2] < 0 ? 1 : c[2] < 40 ? 2 : 3);
     }
     /// Do the faces of each group fit @p printerMm with @p marginMm?
     bool groupsFit(const RegionMerge& m, const Vec3d& printerMm, double marginMm) const {
         std::vector<std::vector<Vec3d>> pts(m.groupCount);
         for (size_t f = 0; f < regionOf.size(); ++f)
-            for (uint32_t v : mesh.triangles[f]) pts[m.groupOf[regionOf[f]]].push_back(toD(mesh.positions[v]));
-        return std::all_of(pts.begin(), pts.end(),
-                           [&](const std::vector<Vec3d>& p) { return fitInPrinter(p, printerMm, marginMm).fits; });
+            for (uint32_t v : mesh.triangles[f])
+                pts[m.groupOf[regionOf[f]]].push_back(toD(mesh.positions[v]));
+        return std::all_of(pts.begin(), pts.end(), [&](const std::vector<Vec3d>& p) {
+            return fitInPrinter(p, printerMm, marginMm).fits;
+        });
     }
 };
 
@@ -88,10 +91,12 @@ TEST_CASE("region merge: the small bunny in a small printer ends with fewer piec
     PartitionOptions o;
     Fabrication fab;
     fab.printerMm = {120, 120, 120};
-    const PartitionResult merged = partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent());
+    const PartitionResult merged =
+        partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent());
     PartitionOptions off = o;
     off.mergeSmallRegions = false;
-    const PartitionResult plain = partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, off, RunContext::silent());
+    const PartitionResult plain =
+        partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, off, RunContext::silent());
     CHECK(plain.regionMerges == 0);
     CHECK(merged.regionMerges > 0);
     CHECK(merged.pieces.size() < plain.pieces.size());

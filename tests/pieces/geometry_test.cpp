@@ -56,7 +56,9 @@ uint32_t readU32(const std::string& s, size_t at) {
     for (int i = 3; i >= 0; --i) v = (v << 8) | uint8_t(s[at + size_t(i)]);
     return v;
 }
-uint16_t readU16(const std::string& s, size_t at) { return uint16_t(uint8_t(s[at]) | (uint8_t(s[at + 1]) << 8)); }
+uint16_t readU16(const std::string& s, size_t at) {
+    return uint16_t(uint8_t(s[at]) | (uint8_t(s[at + 1]) << 8));
+}
 
 /// Entries of a zip archive (local headers walked in order; deflated data inflated, CRC checked).
 std::map<std::string, std::string> unzip(const std::string& zip) {
@@ -64,7 +66,8 @@ std::map<std::string, std::string> unzip(const std::string& zip) {
     size_t at = 0;
     while (at + 4 <= zip.size() && readU32(zip, at) == 0x04034b50) {
         const uint16_t method = readU16(zip, at + 8);
-        const uint32_t crc = readU32(zip, at + 14), csize = readU32(zip, at + 18), usize = readU32(zip, at + 22);
+        const uint32_t crc = readU32(zip, at + 14), csize = readU32(zip, at + 18),
+                       usize = readU32(zip, at + 22);
         const uint16_t nameLen = readU16(zip, at + 26), extraLen = readU16(zip, at + 28);
         const std::string name = zip.substr(at + 30, nameLen);
         const std::string body = zip.substr(at + 30 + nameLen + extraLen, csize);
@@ -170,7 +173,8 @@ TEST_CASE("tenons: rays from one ball in a spherical shell") {
     TenonOptions o;
     o.latticeHolesOnly = true;  // the paper's six
     const double inner = 30.0;
-    const auto candidates = findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0, 5.0), o);
+    const auto candidates =
+        findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0, 5.0), o);
     REQUIRE(candidates.size() == 6);
     for (const TenonCandidate& c : candidates) {
         INFO("hole " << c.tenon.hole);
@@ -187,7 +191,8 @@ TEST_CASE("tenons: rays from one ball in a spherical shell") {
     // straight on, in the piece its axis meets, with the peg's long side along the hole's rectangle;
     // the others are rays whose prism the cut at z = 5 runs through.
     TenonOptions allBlue;
-    const auto all = findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0, 5.0), allBlue);
+    const auto all =
+        findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0, 5.0), allBlue);
     REQUIRE(all.size() == 30);
     std::set<int> holes;
     int accepted = 0;
@@ -206,17 +211,20 @@ TEST_CASE("tenons: rays from one ball in a spherical shell") {
         CHECK(c.tenon.tiltDeg < 1.0);
         CHECK(c.piece == (hitZ > 5.0 ? 0 : 1));
         const Vec3d& side = zome::holeSectionAxis(c.tenon.hole);
-        for (int k = 0; k < 3; ++k) CHECK(c.tenon.longSideGrid[size_t(k)] == doctest::Approx(side[size_t(k)]));
+        for (int k = 0; k < 3; ++k)
+            CHECK(c.tenon.longSideGrid[size_t(k)] == doctest::Approx(side[size_t(k)]));
     }
     CHECK(holes.size() == 30);
     CHECK(accepted >= 24);
     // Too far: a 15 mm limit (the rays look twice as far, so the wall 21 mm away is seen).
     TenonOptions shortOnes = o;
     shortOnes.maxLengthMm = 15;
-    for (const TenonCandidate& c : findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0), shortOnes))
+    for (const TenonCandidate& c :
+         findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0), shortOnes))
         CHECK(c.rejection == "too far from the wall");
     // Nothing within reach.
-    for (const TenonCandidate& c : findTenonCandidates(frame, Transform4d::identity(), sphereProbe(200, 210), o))
+    for (const TenonCandidate& c :
+         findTenonCandidates(frame, Transform4d::identity(), sphereProbe(200, 210), o))
         CHECK(c.rejection == "no wall within reach");
 }
 
@@ -249,7 +257,8 @@ TEST_CASE("tenons: used holes, obstacles, oblique walls and cut edges are reject
     strict.maxLengthMm = 100;
     strict.maxTiltDeg = 20;
     bool sawOblique = false;
-    for (const TenonCandidate& c : findTenonCandidates(off, Transform4d::identity(), sphereProbe(100, 110), strict))
+    for (const TenonCandidate& c :
+         findTenonCandidates(off, Transform4d::identity(), sphereProbe(100, 110), strict))
         if (c.tenon.hole == 1) {
             CHECK(c.rejection == "surface too oblique");
             CHECK(c.tenon.tiltDeg > 20);
@@ -308,8 +317,9 @@ TEST_CASE("tenons: the choice gives every piece its share, prefers one direction
     for (const auto& list : plan.perPiece) all.insert(all.end(), list.begin(), list.end());
     for (size_t i = 0; i < all.size(); ++i)
         for (size_t j = i + 1; j < all.size(); ++j) {
-            const double d2 = zome::segmentSegmentDistanceSq(all[i].pointAt(all[i].shoulderMm), all[i].pointAt(all[i].endMm),
-                                                             all[j].pointAt(all[j].shoulderMm), all[j].pointAt(all[j].endMm));
+            const double d2 = zome::segmentSegmentDistanceSq(
+                all[i].pointAt(all[i].shoulderMm), all[i].pointAt(all[i].endMm),
+                all[j].pointAt(all[j].shoulderMm), all[j].pointAt(all[j].endMm));
             CHECK(std::sqrt(d2) >= 2 * bodyRadiusMm(o));
         }
     // maxPerPiece 0: none at all.
@@ -333,9 +343,11 @@ TEST_CASE("tenons: a rotated frame rotates the axes and the peg") {
     for (const TenonCandidate& cand : candidates) {
         CHECK(cand.rejection.empty());
         const Vec3d expected = applyLinear(rot, zome::holeDirection(cand.tenon.hole));
-        for (int a = 0; a < 3; ++a) CHECK(cand.tenon.axisGrid[size_t(a)] == doctest::Approx(expected[size_t(a)]));
+        for (int a = 0; a < 3; ++a)
+            CHECK(cand.tenon.axisGrid[size_t(a)] == doctest::Approx(expected[size_t(a)]));
         const Vec3d longSide = applyLinear(rot, zome::holeSectionAxis(cand.tenon.hole));
-        for (int a = 0; a < 3; ++a) CHECK(cand.tenon.longSideGrid[size_t(a)] == doctest::Approx(longSide[size_t(a)]));
+        for (int a = 0; a < 3; ++a)
+            CHECK(cand.tenon.longSideGrid[size_t(a)] == doctest::Approx(longSide[size_t(a)]));
         CHECK(cand.tenon.baseMm == doctest::Approx(30).epsilon(1e-6));
     }
 }
@@ -423,7 +435,8 @@ TEST_CASE("orientation: a piece no cut face can carry rests on its largest side,
     transformInPlace(placed, o.transformMm);
     double bedMm2 = 0;
     for (const Triangle& t : placed.triangles) {
-        const Vec3d a = toD(placed.positions[t[0]]), b = toD(placed.positions[t[1]]), c = toD(placed.positions[t[2]]);
+        const Vec3d a = toD(placed.positions[t[0]]), b = toD(placed.positions[t[1]]),
+                    c = toD(placed.positions[t[2]]);
         const Vec3d n = cross(sub(b, a), sub(c, a));
         if (std::max({a[2], b[2], c[2]}) < 1e-3 && n[2] < 0) bedMm2 += 0.5 * norm(n);
     }
@@ -435,7 +448,8 @@ TEST_CASE("orientation: a piece no cut face can carry rests on its largest side,
     CHECK(side.note.find("1 under 100 mm²") != std::string::npos);
 
     if (!report::isSlicerAvailable()) {
-        MESSAGE("prusa-slicer is not installed (apt-get install --no-install-recommends prusa-slicer): skipped");
+        MESSAGE(
+            "prusa-slicer is not installed (apt-get install --no-install-recommends prusa-slicer): skipped");
         return;
     }
     // The project's profile (report::prusaSlicerArguments); it throws on "no extrusions in the
@@ -467,7 +481,8 @@ TEST_CASE("label: seven-segment strokes, an underline, centred") {
     PieceLabel label{"1", {0, 0, 0}, {0, 0, 1}, {0, 1, 0}, size[0], size[1]};
     const Stroke& s = one[0];
     CHECK(labelSignedDistanceMm(label, one, o, {s.centerX, s.centerY, -0.5 * o.depthMm}) < 0);
-    CHECK(labelSignedDistanceMm(label, one, o, {s.centerX, s.centerY, -o.depthMm - 0.3}) == doctest::Approx(0.3));
+    CHECK(labelSignedDistanceMm(label, one, o, {s.centerX, s.centerY, -o.depthMm - 0.3}) ==
+          doctest::Approx(0.3));
     // Readable from the cavity (+z): the right side of the text is +x = up × normal.
     const auto two = labelStrokes("2", o);  // "2" has its upper vertical on the right
     bool hasUpperRight = false;
@@ -479,8 +494,9 @@ TEST_CASE("label: seven-segment strokes, an underline, centred") {
 TEST_CASE("3mf: a deterministic OPC zip with the model in millimetres") {
     const TriMesh a = zomefab::test::makeBox({0, 0, 0}, {10, 20, 30});
     const TriMesh b = zomefab::test::makeBox({-5, -5, 0}, {5, 5, 5});
-    const std::vector<ThreeMfObject> objects = {{"piece-00", &a, Transform4d::identity()},
-                                                {"piece<01>", &b, Transform4d::scaleTranslate(1, {210, 0, 0})}};
+    const std::vector<ThreeMfObject> objects = {
+        {"piece-00", &a, Transform4d::identity()},
+        {"piece<01>", &b, Transform4d::scaleTranslate(1, {210, 0, 0})}};
     const std::string bytes = threeMfBytes(objects, "zomefab test");
     CHECK(bytes == threeMfBytes(objects, "zomefab test"));
     const auto entries = unzip(bytes);

@@ -2,9 +2,9 @@
 #include "pieces_fixtures.h"
 
 #include <cmath>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
-#include <fstream>
 #include "test_util.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/run_context.h"
@@ -48,7 +48,8 @@ zome::Structure makeCubeLattice(double maxRadiusMm) {
         for (int j = -n; j <= n; ++j)
             for (int k = -n; k <= n; ++k)
                 if (std::sqrt(double(i * i + j * j + k * k)) * b0 <= maxRadiusMm)
-                    s.addBall(zome::GoldenVector3(step * zome::Golden(i), step * zome::Golden(j), step * zome::Golden(k)));
+                    s.addBall(zome::GoldenVector3(step * zome::Golden(i), step * zome::Golden(j),
+                                                  step * zome::Golden(k)));
     for (zome::BallId a : s.ballIds())
         for (int hole : {0, 1, 2}) {
             const zome::GoldenVector3 end = s.ball(a).position + zome::strutVector(hole, 0);

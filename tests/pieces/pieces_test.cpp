@@ -2,6 +2,8 @@
 // makePieces end to end on a 200 mm spherical shell with a B0 cube lattice inside: the pieces'
 // union is the shell, every mesh is closed and fits the printer, tenons are exact and clear of the
 // frame, slivers are merged, the number is engraved, and results do not depend on the threads.
+#include "zomefab/pieces/pieces.h"
+
 #include <doctest/doctest.h>
 #include <tbb/global_control.h>
 
@@ -18,7 +20,6 @@
 #include "zomefab/mesh/mesh_check.h"
 #include "zomefab/pieces/detail/box_distance.h"
 #include "zomefab/pieces/orientation.h"
-#include "zomefab/pieces/pieces.h"
 #include "zomefab/pieces/pieces_io.h"
 #include "zomefab/zome/zome_system.h"
 
@@ -77,7 +78,8 @@ void checkClosedAndFits(const Pieces& result) {
         // A cut face down means flat triangles on the bed facing down.
         double bedArea = 0;
         for (const Triangle& t : p.mesh.triangles) {
-            const Vec3d a = toD(p.mesh.positions[t[0]]), b = toD(p.mesh.positions[t[1]]), c = toD(p.mesh.positions[t[2]]);
+            const Vec3d a = toD(p.mesh.positions[t[0]]), b = toD(p.mesh.positions[t[1]]),
+                        c = toD(p.mesh.positions[t[2]]);
             if (std::max({a[2], b[2], c[2]}) > 1e-3) continue;
             const Vec3d n = cross(sub(b, a), sub(c, a));
             if (n[2] < 0) bedArea += 0.5 * norm(n);
@@ -192,7 +194,8 @@ TEST_CASE("pieces: tenons use free blue holes, end at the ball's face and clear 
                 // Only a peg may enter a ball: within the peg's box of a tenon into that ball.
                 bool isPeg = false;
                 for (const Tenon& t : p.tenons)
-                    if (t.ball == b && tenonSignedDistanceMm(t, o.tenons, x) < 0.5 && dot(sub(x, t.ballCenterGridMm), t.axisGrid) > 0)
+                    if (t.ball == b && tenonSignedDistanceMm(t, o.tenons, x) < 0.5 &&
+                        dot(sub(x, t.ballCenterGridMm), t.axisGrid) > 0)
                         isPeg = true;
                 CHECK(isPeg);
             }
@@ -279,7 +282,8 @@ TEST_CASE("pieces: bad inputs and options") {
     bad.pieces.resize(1);
     bad.pieces[0].cells = {5};
     CHECK(codeOf(bad, plainOptions()) == int(ErrorCode::InvalidInput));
-    CHECK(codeOf(cells, plainOptions(), Transform4d::scaleTranslate(2.0, {0, 0, 0})) == int(ErrorCode::InvalidInput));
+    CHECK(codeOf(cells, plainOptions(), Transform4d::scaleTranslate(2.0, {0, 0, 0})) ==
+          int(ErrorCode::InvalidInput));
     partition::PartitionResult empty;
     CHECK(codeOf(empty, plainOptions()) == int(ErrorCode::InvalidInput));
     PiecesOptions o = plainOptions();
@@ -289,7 +293,8 @@ TEST_CASE("pieces: bad inputs and options") {
     const sdf::LevelSet coarse = makeSphereShell({0, 0, 0}, 60.0, 8.0, 2.0);
     PiecesOptions withTenons;
     try {
-        makePieces(coarse, frame(), Transform4d::identity(), cells, Fabrication{}, withTenons, RunContext::silent());
+        makePieces(coarse, frame(), Transform4d::identity(), cells, Fabrication{}, withTenons,
+                   RunContext::silent());
         FAIL("no error");
     } catch (const Error& e) {
         CHECK(e.code() == ErrorCode::Usage);
@@ -344,7 +349,8 @@ TEST_CASE("pieces: the engraved number is cut into the inner surface") {
 TEST_CASE("pieces: a frame rotated about the vertical and shifted") {
     const double a = 0.3;
     Transform4d frameToGrid;
-    frameToGrid.m = {std::cos(a), -std::sin(a), 0, 4.0, std::sin(a), std::cos(a), 0, -6.0, 0, 0, 1, 3.0, 0, 0, 0, 1};
+    frameToGrid.m = {
+        std::cos(a), -std::sin(a), 0, 4.0, std::sin(a), std::cos(a), 0, -6.0, 0, 0, 1, 3.0, 0, 0, 0, 1};
     // The shell stays centred at the origin of the grid; the frame (made around its own origin)
     // is placed by frameToGrid, so keep it well inside: a smaller lattice.
     const zome::Structure small = makeCubeLattice(60.0);
@@ -352,7 +358,8 @@ TEST_CASE("pieces: a frame rotated about the vertical and shifted") {
     PiecesOptions o;
     o.label.isEnabled = false;
     o.tenons.maxTiltDeg = 35;
-    const Pieces result = makePieces(shell(), small, frameToGrid, cells, Fabrication{}, o, RunContext::silent());
+    const Pieces result =
+        makePieces(shell(), small, frameToGrid, cells, Fabrication{}, o, RunContext::silent());
     REQUIRE(result.pieces.size() == 4);
     checkClosedAndFits(result);
     size_t total = 0;
@@ -399,12 +406,14 @@ TEST_CASE("pieces: the same result with 1 and 2 threads, and the written files")
     o.tenons.maxTiltDeg = 35;
     auto run = [&](int threads) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-        return makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{}, o, RunContext::silent());
+        return makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{}, o,
+                          RunContext::silent());
     };
     const Pieces one = run(1), two = run(2);
     REQUIRE(one.pieces.size() == two.pieces.size());
     for (size_t i = 0; i < one.pieces.size(); ++i)
-        CHECK(serializeMesh(one.pieces[i].mesh, MeshFormat::Stl) == serializeMesh(two.pieces[i].mesh, MeshFormat::Stl));
+        CHECK(serializeMesh(one.pieces[i].mesh, MeshFormat::Stl) ==
+              serializeMesh(two.pieces[i].mesh, MeshFormat::Stl));
     const PiecesJsonInfo info{"shell.vdb", "frame.json", "partition.json"};
     CHECK(piecesToJson(one, info).dump() == piecesToJson(two, info).dump());
 
@@ -437,6 +446,7 @@ TEST_CASE("pieces: the same result with 1 and 2 threads, and the written files")
     CHECK(std::filesystem::exists(foreign + "/keep.txt"));
     CHECK_THROWS_AS(writePieces(one, dir.file("no/such/parent"), info), Error);
     size_t entries = 0;
-    for (const auto& e : std::filesystem::directory_iterator(dir.path())) entries += e.path().filename().string()[0] == '.';
+    for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+        entries += e.path().filename().string()[0] == '.';
     CHECK(entries == 0);  // no staging directory left
 }

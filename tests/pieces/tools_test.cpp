@@ -21,7 +21,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool isInstalled(const std::string& program) { return test::runShell("command -v " + program + " > /dev/null") == 0; }
+bool isInstalled(const std::string& program) {
+    return test::runShell("command -v " + program + " > /dev/null") == 0;
+}
 
 /// The inputs and one zf-pieces run, shared by the cases (the run takes a few seconds).
 struct Run {
@@ -33,8 +35,9 @@ struct Run {
     }
     /// zf-pieces on the shared inputs into dir/@p outName with @p options; its exit code.
     int runInto(const std::string& outName, const std::string& options) const {
-        return test::runShell(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " + dir.file("frame.json") +
-                              " " + dir.file("partition.json") + " -q " + options + " -o " + dir.file(outName));
+        return test::runShell(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " +
+                              dir.file("frame.json") + " " + dir.file("partition.json") + " -q " + options +
+                              " -o " + dir.file(outName));
     }
     std::string out(const std::string& name) const { return dir.file("out/" + name); }
 };
@@ -112,7 +115,8 @@ TEST_CASE("zf-pieces: the same bytes with 1 and 2 threads") {
     for (const auto& e : fs::directory_iterator(r.dir.file("out"))) {
         ++files;
         INFO(e.path().filename().string());
-        CHECK(test::readFile(e.path().string()) == test::readFile(other + "/" + e.path().filename().string()));
+        CHECK(test::readFile(e.path().string()) ==
+              test::readFile(other + "/" + e.path().filename().string()));
     }
     CHECK(files == 6);  // 4 STL, 3MF, JSON
 }
@@ -131,8 +135,8 @@ TEST_CASE("zf-pieces: admesh loads every piece with no errors and nothing to rep
         const std::string report = test::readFile(log);
         INFO(file << "\n" << report);
         CHECK(admeshField(report, "Total disconnected facets") == "0                   0");
-        for (const char* field : {"Degenerate facets", "Edges fixed", "Facets removed", "Facets added", "Facets reversed",
-                                  "Backwards edges", "Normals fixed"})
+        for (const char* field : {"Degenerate facets", "Edges fixed", "Facets removed", "Facets added",
+                                  "Facets reversed", "Backwards edges", "Normals fixed"})
             CHECK(admeshField(report, field) == "0");
         CHECK(report.find("Binary STL file") != std::string::npos);
     }
@@ -140,7 +144,8 @@ TEST_CASE("zf-pieces: admesh loads every piece with no errors and nothing to rep
 
 TEST_CASE("zf-pieces: PrusaSlicer slices a piece and loads the 3MF") {
     if (!isInstalled("prusa-slicer")) {
-        MESSAGE("prusa-slicer is not installed (apt-get install --no-install-recommends prusa-slicer): skipped");
+        MESSAGE(
+            "prusa-slicer is not installed (apt-get install --no-install-recommends prusa-slicer): skipped");
         return;
     }
     const Run& r = shared();
@@ -148,19 +153,22 @@ TEST_CASE("zf-pieces: PrusaSlicer slices a piece and loads the 3MF") {
     // The printer's own 200 mm bed: PrusaSlicer refuses parts that do not fit it
     // (../shared/docs/print-estimates.md). Coarse layers keep this quick.
     const std::string gcode = r.dir.file("piece.gcode");
-    const int code = test::runShell("prusa-slicer --loglevel 1 --export-gcode --layer-height 0.3 --first-layer-height 0.3 "
-                         "--nozzle-diameter 0.4 --filament-diameter 2.85 --fill-density 10% --perimeters 2 "
-                         "--gcode-flavor marlin2 --bed-shape 0x0,200x0,200x200,0x200 --max-print-height 200 -o " +
-                         gcode + " " + r.out("piece-00.stl") + " > " + r.dir.file("slicer.txt") + " 2>&1");
+    const int code = test::runShell(
+        "prusa-slicer --loglevel 1 --export-gcode --layer-height 0.3 --first-layer-height 0.3 "
+        "--nozzle-diameter 0.4 --filament-diameter 2.85 --fill-density 10% --perimeters 2 "
+        "--gcode-flavor marlin2 --bed-shape 0x0,200x0,200x200,0x200 --max-print-height 200 -o " +
+        gcode + " " + r.out("piece-00.stl") + " > " + r.dir.file("slicer.txt") + " 2>&1");
     INFO(test::readFile(r.dir.file("slicer.txt")));
     CHECK(code == 0);
     CHECK(test::readFile(gcode).find("; estimated printing time") != std::string::npos);
 
-    REQUIRE(test::runShell("prusa-slicer --loglevel 1 --info " + r.out("pieces.3mf") + " > " + r.dir.file("info.txt") + " 2>&1") == 0);
+    REQUIRE(test::runShell("prusa-slicer --loglevel 1 --info " + r.out("pieces.3mf") + " > " +
+                           r.dir.file("info.txt") + " 2>&1") == 0);
     const std::string info = test::readFile(r.dir.file("info.txt"));
     INFO(info);
     size_t manifold = 0;
-    for (size_t at = info.find("manifold = yes"); at != std::string::npos; at = info.find("manifold = yes", at + 1))
+    for (size_t at = info.find("manifold = yes"); at != std::string::npos;
+         at = info.find("manifold = yes", at + 1))
         ++manifold;
     CHECK(manifold == 4);
     CHECK(info.find("manifold = no") == std::string::npos);
@@ -174,14 +182,17 @@ TEST_CASE("zf-pieces: the real chain zf-sdf, zf-shell, zf-frame, zf-partition, z
         }
     test::ScratchDir dir("zomefab-pieces-chain");
     const std::string bunny = test::dataPath("bunny_npm_3674.stl");
-    REQUIRE(test::runShell(test::toolPath("zf-sdf") + " " + bunny + " --height-mm 250 --up y --shell-mm 10 -q -o " +
-                dir.file("bunny.vdb")) == 0);
-    REQUIRE(test::runShell(test::toolPath("zf-shell") + " " + dir.file("bunny.vdb") + " --shell-mm 10 -q -o " + dir.file("shell.vdb")) == 0);
-    REQUIRE(test::runShell(test::toolPath("zf-frame") + " " + dir.file("bunny.vdb") + " --frame-clearance-mm 10 -q -o " + dir.file("frame.json")) == 0);
-    REQUIRE(test::runShell(test::toolPath("zf-partition") + " " + bunny + " " + dir.file("frame.json") + " -q -o " +
-                dir.file("partition.json")) == 0);
-    REQUIRE(test::runShell(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " + dir.file("frame.json") + " " +
-                dir.file("partition.json") + " -q -o " + dir.file("out")) == 0);
+    REQUIRE(test::runShell(test::toolPath("zf-sdf") + " " + bunny +
+                           " --height-mm 250 --up y --shell-mm 10 -q -o " + dir.file("bunny.vdb")) == 0);
+    REQUIRE(test::runShell(test::toolPath("zf-shell") + " " + dir.file("bunny.vdb") +
+                           " --shell-mm 10 -q -o " + dir.file("shell.vdb")) == 0);
+    REQUIRE(test::runShell(test::toolPath("zf-frame") + " " + dir.file("bunny.vdb") +
+                           " --frame-clearance-mm 10 -q -o " + dir.file("frame.json")) == 0);
+    REQUIRE(test::runShell(test::toolPath("zf-partition") + " " + bunny + " " + dir.file("frame.json") +
+                           " -q -o " + dir.file("partition.json")) == 0);
+    REQUIRE(test::runShell(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " +
+                           dir.file("frame.json") + " " + dir.file("partition.json") + " -q -o " +
+                           dir.file("out")) == 0);
     const nlohmann::json j = nlohmann::json::parse(test::readFile(dir.file("out/pieces.json")));
     const nlohmann::json partition = nlohmann::json::parse(test::readFile(dir.file("partition.json")));
     REQUIRE(j["pieces"].size() >= 2);

@@ -92,7 +92,8 @@ TEST_CASE("long: the frame passes zf-zome check; every parts list equals the fra
     const std::string guide = readInputBytes(d.file("assembly.md"));
     std::map<std::string, int> seen;
     const std::regex ballHeading(R"(\*\*ball-(\d+)\*\* at)");
-    for (auto it = std::sregex_iterator(guide.begin(), guide.end(), ballHeading); it != std::sregex_iterator(); ++it)
+    for (auto it = std::sregex_iterator(guide.begin(), guide.end(), ballHeading);
+         it != std::sregex_iterator(); ++it)
         ++seen[(*it)[1]];
     CHECK(seen.size() == frame.ballCount());
     for (const auto& [ball, count] : seen) CHECK(count == 1);
@@ -150,7 +151,8 @@ TEST_CASE("long: preview.glb passes the Khronos validator and its Draco pieces d
     for (const json& n : g.json["nodes"]) names.insert(n.value("name", ""));
     for (size_t i = 0; i < d.result.pieces.pieces.size(); ++i)
         CHECK(names.count(pieces::pieceName(d.result.pieces, i)) == 1);
-    for (const zome::BallId id : d.result.frame.structure.ballIds()) CHECK(names.count("ball-" + std::to_string(id)) == 1);
+    for (const zome::BallId id : d.result.frame.structure.ballIds())
+        CHECK(names.count("ball-" + std::to_string(id)) == 1);
     CHECK(g.json["scenes"][0]["extras"]["parts"] == partsJson(d.result.cost.parts));
 
     if (!test::hasCommand("draco_decoder")) {
@@ -162,9 +164,12 @@ TEST_CASE("long: preview.glb passes the Khronos validator and its Draco pieces d
             for (const json& prim : mesh["primitives"]) {
                 if (!prim.contains("extensions")) continue;
                 const std::string drc = scratch.file("m.drc");
-                test::writeBytes(drc, test::viewBytes(g, prim["extensions"]["KHR_draco_mesh_compression"]["bufferView"]));
+                test::writeBytes(
+                    drc, test::viewBytes(g, prim["extensions"]["KHR_draco_mesh_compression"]["bufferView"]));
                 const auto [vertices, faces] = test::dracoDecodeCounts(drc, scratch.file("m.obj"));
-                CHECK(vertices == g.json["accessors"][prim["attributes"]["POSITION"].get<size_t>()]["count"].get<size_t>());
+                CHECK(
+                    vertices ==
+                    g.json["accessors"][prim["attributes"]["POSITION"].get<size_t>()]["count"].get<size_t>());
                 CHECK(3 * faces == g.json["accessors"][prim["indices"].get<size_t>()]["count"].get<size_t>());
                 ++decoded;
             }
@@ -182,7 +187,8 @@ TEST_CASE("long: preview.glb passes the Khronos validator and its Draco pieces d
 
 TEST_CASE("long: the estimator agrees with PrusaSlicer within 15 % on the pieces and the baseline") {
     if (!report::isSlicerAvailable()) {
-        MESSAGE("prusa-slicer is not installed (apt-get install --no-install-recommends prusa-slicer): skipped");
+        MESSAGE(
+            "prusa-slicer is not installed (apt-get install --no-install-recommends prusa-slicer): skipped");
         return;
     }
     // Slicing all 2 × (pieces + baseline parts) takes about 20 minutes on 2 cores (`zomefab run
@@ -216,11 +222,13 @@ TEST_CASE("long: the estimator agrees with PrusaSlicer within 15 % on the pieces
         report::PrintEstimate estimated, sliced;
         for (size_t i = 0; i < sample.parts.size(); ++i) {
             estimated += report::estimatePrint(*sample.parts[i], settings, cost.rates);
-            sliced += report::sliceWithPrusaSlicer(*sample.parts[i], settings, std::string(sample.what) + " " + std::to_string(i));
+            sliced += report::sliceWithPrusaSlicer(*sample.parts[i], settings,
+                                                   std::string(sample.what) + " " + std::to_string(i));
         }
-        MESSAGE(sample.what << " at " << sample.infillPercent << "% (" << sample.parts.size() << " parts): "
-                            << estimated.hours() << " / " << sliced.hours() << " h, " << estimated.filamentMm3 / 1000
-                            << " / " << sliced.filamentMm3 / 1000 << " cm3 (estimator / PrusaSlicer)");
+        MESSAGE(sample.what << " at " << sample.infillPercent << "% (" << sample.parts.size()
+                            << " parts): " << estimated.hours() << " / " << sliced.hours() << " h, "
+                            << estimated.filamentMm3 / 1000 << " / " << sliced.filamentMm3 / 1000
+                            << " cm3 (estimator / PrusaSlicer)");
         CHECK(relativeError(estimated.seconds, sliced.seconds) <= 0.15);
         CHECK(relativeError(estimated.filamentMm3, sliced.filamentMm3) <= 0.15);
     }

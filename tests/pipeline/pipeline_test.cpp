@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include "zomefab/pipeline/pipeline.h"
+
 #include <doctest/doctest.h>
 
 #include <filesystem>
@@ -9,7 +11,6 @@
 #include "zomefab/core/error.h"
 #include "zomefab/io/file_io.h"
 #include "zomefab/io/mesh_io.h"
-#include "zomefab/pipeline/pipeline.h"
 #include "zomefab/report/run_report.h"
 #include "zomefab/zome/parts.h"
 #include "zomefab/zome/structure_json.h"
@@ -45,15 +46,17 @@ TEST_CASE("pipeline: the small bunny end to end, outputs consistent with each ot
     const nlohmann::json report = report::runReportJson(result, RunContext::silent());
     const auto files = pipeline::writeRunOutputs(result, options, report, out);
     for (const std::string& f : files) CHECK(fs::exists(fs::path(out) / f));
-    CHECK(files == std::vector<std::string>{"assembly.md", "cost.md", "frame.json", "frame.vef", "partition.json",
-                                            "pieces.3mf", "pieces/", "preview.glb", "report.json"});
+    CHECK(files == std::vector<std::string>{"assembly.md", "cost.md", "frame.json", "frame.vef",
+                                            "partition.json", "pieces.3mf", "pieces/", "preview.glb",
+                                            "report.json"});
     CHECK(!fs::exists(out + "/pieces/pieces.3mf"));  // moved up, next to the preview
     // The cost report prices exactly the pieces written and the frame's parts.
     CHECK(report["cost"]["pieces"] == result.pieces.pieces.size());
     CHECK(report["cost"]["pieces_volume_mm3"].get<double>() ==
           doctest::Approx(report["pieces"]["volume_mm3"].get<double>()).epsilon(1e-6));
     CHECK(report["cost"]["zometool"]["balls"] == report["frame"]["balls"]);
-    for (const char* key : {"material_saved_hollow_percent", "time_saved_hollow_percent", "material_saved_solid_percent"})
+    for (const char* key :
+         {"material_saved_hollow_percent", "time_saved_hollow_percent", "material_saved_solid_percent"})
         CHECK(report["cost"][key].is_number());
     CHECK(report["cost"]["source"] == "estimator");
     const std::string costMd = readInputBytes(out + "/cost.md");

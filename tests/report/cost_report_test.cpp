@@ -116,7 +116,8 @@ TEST_CASE("cost_report: a part the slicer fails on is estimated instead, with a 
             if (level == LogLevel::Warning) warnings.push_back(m);
         },
         nullptr);
-    const CostReport r = costReport(object, test::pointersTo(pieces), bunnyParts(), Fabrication{}, o, context);
+    const CostReport r =
+        costReport(object, test::pointersTo(pieces), bunnyParts(), Fabrication{}, o, context);
     CHECK(r.slicerFallbacks ==
           std::vector<std::string>{"hollow piece 0 at 20%", "hollow baseline part 0 at 20%",
                                    "solid piece 0 at 100%", "solid baseline part 0 at 100%"});
@@ -138,8 +139,10 @@ TEST_CASE("cost_report: filament options change cost and length, not time") {
     CostOptions cheap;
     cheap.filament.usdPerM = 0.28;
     cheap.filament.diameterMm = 1.75;
-    const CostReport a = costReport(sphere.object, test::pointersTo(sphere.pieces), bunnyParts(), Fabrication{});
-    const CostReport b = costReport(sphere.object, test::pointersTo(sphere.pieces), bunnyParts(), Fabrication{}, cheap);
+    const CostReport a =
+        costReport(sphere.object, test::pointersTo(sphere.pieces), bunnyParts(), Fabrication{});
+    const CostReport b =
+        costReport(sphere.object, test::pointersTo(sphere.pieces), bunnyParts(), Fabrication{}, cheap);
     const double area = (2.85 * 2.85) / (1.75 * 1.75);
     CHECK(b.cases[0].zomefab.filament.lengthM == doctest::Approx(a.cases[0].zomefab.filament.lengthM * area));
     CHECK(b.cases[0].zomefab.filament.costUsd ==
@@ -148,5 +151,6 @@ TEST_CASE("cost_report: filament options change cost and length, not time") {
     CostOptions bad;
     Fabrication badPrinter;
     badPrinter.printerMm = {200, -1, 200};
-    CHECK_THROWS_AS(costReport(sphere.object, test::pointersTo(sphere.pieces), bunnyParts(), badPrinter, bad), Error);
+    CHECK_THROWS_AS(costReport(sphere.object, test::pointersTo(sphere.pieces), bunnyParts(), badPrinter, bad),
+                    Error);
 }

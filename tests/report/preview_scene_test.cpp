@@ -76,7 +76,8 @@ TEST_CASE("preview_scene: strut cross-sections have the Zome model's sizes") {
 TEST_CASE("preview_scene: pieces, one instanced ball mesh, one mesh per strut kind") {
     const zome::Structure frame = colourFrame();
     PreviewInput input;
-    const std::vector<TriMesh> meshes{makeBox({-30, -30, -30}, {0, 0, 0}), makeSphere({80, 0, 0}, 20, 12, 24)};
+    const std::vector<TriMesh> meshes{makeBox({-30, -30, -30}, {0, 0, 0}),
+                                      makeSphere({80, 0, 0}, 20, 12, 24)};
     input.pieces = test::pointersTo(meshes);
     input.pieceNames = {"piece-00", "piece-01"};
     input.frame = &frame;

@@ -1,6 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file The print estimator's volume model, filament conversions and the octree baseline.
-#include "zomefab/core/fabrication.h"
 #include "zomefab/report/print_estimate.h"
 
 #include <doctest/doctest.h>
@@ -10,6 +9,7 @@
 #include "report_fixtures.h"
 #include "report_test_util.h"
 #include "zomefab/core/error.h"
+#include "zomefab/core/fabrication.h"
 #include "zomefab/report/mesh_clip.h"
 
 using namespace zomefab;

@@ -45,8 +45,8 @@ TEST_CASE("zf-preview: frame and a directory of pieces (STL and GLB)") {
                                dir.file("pieces/piece-01.glb"));
     std::string err;
     REQUIRE(runCapture(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces") + " -o " +
-                    dir.file("p.glb") + " 2>&1",
-                &err) == 0);
+                           dir.file("p.glb") + " 2>&1",
+                       &err) == 0);
     CHECK(err.find("8 balls, 12 struts, 2 pieces -> ") != std::string::npos);
     const nlohmann::json j = glbJson(readInputBytes(dir.file("p.glb")));
     const std::set<std::string> names = nodeNames(j);
@@ -63,7 +63,7 @@ TEST_CASE("zf-preview: frame and a directory of pieces (STL and GLB)") {
     // Deterministic, and "-o -" puts exactly the same bytes on stdout.
     std::string stdoutBytes;
     REQUIRE(runCapture(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces") + " -o - -q",
-                &stdoutBytes) == 0);
+                       &stdoutBytes) == 0);
     CHECK(stdoutBytes == readInputBytes(dir.file("p.glb")));
 
     if (!hasCommand("node")) {
@@ -98,8 +98,8 @@ TEST_CASE("zf-preview: pieces.json pieces go back from the printer to the frame'
                                       {"file", "piece-00.stl"},
                                       {"orientation", {{"transform_mm", matrix(gridToPrint)}}}}}}};
     writeBytes(dir.file("pieces.json"), pieces.dump());
-    REQUIRE(runCapture(preview() + " " + cubeFrame() + " --pieces " + dir.path().string() + " --no-draco -o " +
-                dir.file("p.glb") + " -q") == 0);
+    REQUIRE(runCapture(preview() + " " + cubeFrame() + " --pieces " + dir.path().string() +
+                       " --no-draco -o " + dir.file("p.glb") + " -q") == 0);
     const nlohmann::json j = glbJson(readInputBytes(dir.file("p.glb")));
     CHECK(!j.contains("extensionsUsed"));
     const nlohmann::json& accessor =
@@ -115,8 +115,8 @@ TEST_CASE("zf-preview: pieces.json pieces go back from the printer to the frame'
                R"({"format": "zomefab.pieces", "version": 1, "pieces": [{"piece": 0}]})");
     std::string err;
     CHECK(runCapture(preview() + " " + cubeFrame() + " --pieces " + dir.file("pieces.json") + " -o " +
-                  dir.file("bad.glb") + " 2>&1",
-              &err) == 2);
+                         dir.file("bad.glb") + " 2>&1",
+                     &err) == 2);
     CHECK(err.find("pieces.json: pieces[0]: needs \"file\"") != std::string::npos);
     CHECK(!std::filesystem::exists(dir.file("bad.glb")));
 }

@@ -154,7 +154,8 @@ TEST_CASE("level_set: open inputs fail instead of giving garbage") {
         scale.heightMm = 120.0;
         scale.up = mesh::UpAxis::Y;
         const TriMesh mesh = mesh::scaleToMillimetres(readMesh(path), scale).mesh;
-        CHECK(test::errorCodeOf([&] { meshToLevelSet(mesh, {}, RunContext::silent()); }) == ErrorCode::ProcessingFailed);
+        CHECK(test::errorCodeOf([&] { meshToLevelSet(mesh, {}, RunContext::silent()); }) ==
+              ErrorCode::ProcessingFailed);
     }
 }
 
@@ -167,13 +168,16 @@ TEST_CASE("level_set: bad options and inputs give the documented error codes") {
     CHECK(test::errorCodeOf([&] { meshToLevelSet(box, options, RunContext::silent()); }) == ErrorCode::Usage);
     options.voxelMm = 1e-5;  // would need ~10^14 voxels
     CHECK(test::errorCodeOf([&] { meshToLevelSet(box, options, RunContext::silent()); }) == ErrorCode::Usage);
-    CHECK(test::errorCodeOf([&] { meshToLevelSet(TriMesh{}, {}, RunContext::silent()); }) == ErrorCode::InvalidInput);
+    CHECK(test::errorCodeOf([&] { meshToLevelSet(TriMesh{}, {}, RunContext::silent()); }) ==
+          ErrorCode::InvalidInput);
     TriMesh broken = box;
     broken.triangles[3][1] = 99;
-    CHECK(test::errorCodeOf([&] { meshToLevelSet(broken, {}, RunContext::silent()); }) == ErrorCode::InvalidInput);
+    CHECK(test::errorCodeOf([&] { meshToLevelSet(broken, {}, RunContext::silent()); }) ==
+          ErrorCode::InvalidInput);
     broken = box;
     broken.positions[2][0] = std::numeric_limits<float>::infinity();
-    CHECK(test::errorCodeOf([&] { meshToLevelSet(broken, {}, RunContext::silent()); }) == ErrorCode::InvalidInput);
+    CHECK(test::errorCodeOf([&] { meshToLevelSet(broken, {}, RunContext::silent()); }) ==
+          ErrorCode::InvalidInput);
 }
 
 TEST_CASE("level_set: a cancelled context stops the conversion with Cancelled") {

@@ -37,7 +37,6 @@ double quantile(std::vector<double> values, double q);
 /// Distances from each of @p points to @p mesh.
 std::vector<double> distancesTo(const MeshDistance& mesh, const std::vector<Vec3d>& points);
 
-
 /// Edge topology of a triangle mesh.
 struct EdgeReport {
     size_t boundaryEdges = 0;     ///< used by one triangle

@@ -18,8 +18,9 @@ Vec3d parsePrinterMm(const std::string& text) {
     const auto isSeparator = [](char c) { return c == 'x' || c == 'X' || c == ','; };
     if (!(in >> v[0] >> s1 >> v[1] >> s2 >> v[2]) || !isSeparator(s1) || !isSeparator(s2) || (in >> rest) ||
         !(v[0] > 0 && v[1] > 0 && v[2] > 0))
-        throw Error(ErrorCode::Usage,
-                    "--printer-mm: expected three positive sizes in mm, e.g. 200x200x200, got \"" + text + "\"");
+        throw Error(
+            ErrorCode::Usage,
+            "--printer-mm: expected three positive sizes in mm, e.g. 200x200x200, got \"" + text + "\"");
     return v;
 }
 
@@ -27,8 +28,8 @@ partition::SalientSphere parseSalientSphere(const std::string& text) {
     partition::SalientSphere s;
     char c1 = 0, c2 = 0, c3 = 0, rest = 0;
     std::istringstream in(text);
-    if (!(in >> s.centerMm[0] >> c1 >> s.centerMm[1] >> c2 >> s.centerMm[2] >> c3 >> s.radiusMm) || c1 != ',' ||
-        c2 != ',' || c3 != ',' || (in >> rest) || !(s.radiusMm > 0))
+    if (!(in >> s.centerMm[0] >> c1 >> s.centerMm[1] >> c2 >> s.centerMm[2] >> c3 >> s.radiusMm) ||
+        c1 != ',' || c2 != ',' || c3 != ',' || (in >> rest) || !(s.radiusMm > 0))
         throw Error(ErrorCode::Usage, "--salient: expected x,y,z,r in mm with r > 0, got \"" + text + "\"");
     return s;
 }
@@ -38,21 +39,24 @@ std::vector<uint32_t> readSalientFaceList(const std::string& path, size_t faceCo
     if (j.is_discarded()) throw Error(ErrorCode::InvalidInput, "invalid JSON", path);
     if (j.is_object() && j.contains("salient_faces")) j = j["salient_faces"];
     if (!j.is_array())
-        throw Error(ErrorCode::InvalidInput, "expected a list of face indices or {\"salient_faces\": [...]}", path);
+        throw Error(ErrorCode::InvalidInput, "expected a list of face indices or {\"salient_faces\": [...]}",
+                    path);
     std::vector<uint32_t> faces;
     for (const nlohmann::json& v : j) {
         if (!v.is_number_unsigned() || v.get<uint64_t>() >= faceCount)
-            throw Error(ErrorCode::InvalidInput,
-                        "salient face " + v.dump() + " is not a face index below " + std::to_string(faceCount), path);
+            throw Error(
+                ErrorCode::InvalidInput,
+                "salient face " + v.dump() + " is not a face index below " + std::to_string(faceCount), path);
         faces.push_back(v.get<uint32_t>());
     }
     return faces;
 }
 
-zome::Structure readFrame(const std::string& path, Transform4d* transformMm) {
+zome::Structure readFrame(const std::string& path, Transform4d* transformMm, const zome::ZomeScale& physical,
+                          const zome::CollisionOptions& collision) {
     const std::string bytes = readInputBytes(path);
     try {
-        return zome::structureFromJsonText(bytes, {}, {}, transformMm);
+        return zome::structureFromJsonText(bytes, physical, collision, transformMm);
     } catch (const Error& e) {
         throw e.withFile(path);
     }
@@ -77,16 +81,19 @@ void FabricationCli::addTo(CLI::App& app, unsigned parts) {
     if (parts & kPrinter) {
         app.add_option("--printer-mm", printer, "Printer build volume WxDxH in mm")
             ->default_str(formatNumbers("%gx%gx%g", f.printerMm[0], f.printerMm[1], f.printerMm[2]));
-        app.add_option("--fit-margin-mm", f.fitMarginMm, "Grow each side of a piece's box by this before the fit test")
+        app.add_option("--fit-margin-mm", f.fitMarginMm,
+                       "Grow each side of a piece's box by this before the fit test")
             ->capture_default_str();
     }
     if (parts & kWall)
-        app.add_option("--shell-mm", f.wallMm, "Shell wall thickness in mm (paper: dMin = 16)")->capture_default_str();
+        app.add_option("--shell-mm", f.wallMm, "Shell wall thickness in mm (paper: dMin = 16)")
+            ->capture_default_str();
     if (parts & kFrameClearance) {
         app.add_option("--frame-clearance-mm", f.frameClearanceMm,
                        "Forbidden zone dMin: no ball or strut closer to the surface (mm)")
             ->capture_default_str();
-        app.add_option("--b0-mm", f.b0Mm, "Length of the B0 strut, centre to centre (the kit's scale; dMax = b0)")
+        app.add_option("--b0-mm", f.b0Mm,
+                       "Length of the B0 strut, centre to centre (the kit's scale; dMax = b0)")
             ->capture_default_str();
     }
 }
@@ -110,7 +117,8 @@ void FieldCli::addTo(CLI::App& app) {
                    formatNumbers("Voxel of the object and shell level sets (at most %.2f for the tenon pegs)",
                                  pieces::maxVoxelForPegsMm(pieces::TenonOptions{})))
         ->capture_default_str();
-    app.add_option("--field-voxel-mm", options.fieldVoxelMm, "Voxel size of the interior grid (frame optimisation)")
+    app.add_option("--field-voxel-mm", options.fieldVoxelMm,
+                   "Voxel size of the interior grid (frame optimisation)")
         ->capture_default_str();
 }
 
@@ -121,18 +129,21 @@ void FrameCli::addTo(CLI::App& app) {
     app.add_option("--chains", o.chains, "Annealing chains run in parallel; the best is kept")
         ->capture_default_str()
         ->check(CLI::Range(1, 4096));
-    app.add_option("--iterations", o.anneal.maxIterations, "Annealing iterations per chain (0 = until T < --t-end)")
+    app.add_option("--iterations", o.anneal.maxIterations,
+                   "Annealing iterations per chain (0 = until T < --t-end)")
         ->capture_default_str();
     app.add_option("--time-limit", o.anneal.timeLimitSeconds,
                    "Wall-clock budget per chain in seconds (0 = none; makes the result timing-dependent)")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
-    app.add_option("--t-init", o.anneal.initialTemperature, "Initial temperature T_init")->capture_default_str();
+    app.add_option("--t-init", o.anneal.initialTemperature, "Initial temperature T_init")
+        ->capture_default_str();
     app.add_option("--t-end", o.anneal.finalTemperature, "Stop when T < T_end (0 = only the budgets stop)")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
     app.add_option("--cooling", o.anneal.coolingFactor, "Cooling factor C")->capture_default_str();
-    app.add_option("--cooling-interval", o.anneal.coolingIntervalIterations, "Iterations between two cooling steps")
+    app.add_option("--cooling-interval", o.anneal.coolingIntervalIterations,
+                   "Iterations between two cooling steps")
         ->capture_default_str();
     app.add_option("--w-fid", o.energy.fidelityWeight, "Weight of E_fid")->capture_default_str();
     app.add_option("--w-reg", o.energy.regularityWeight, "Weight of E_reg")->capture_default_str();
@@ -144,9 +155,11 @@ void FrameCli::addTo(CLI::App& app) {
     app.add_option("--offset-steps", o.lattice.offsetSteps, "Lattice offsets tried per axis")
         ->capture_default_str()
         ->check(CLI::Range(1, 64));
-    app.add_flag("--search-rotation", o.lattice.searchRotation, "Also search the lattice rotation about the up axis");
-    app.add_flag("--check-moves", o.checkEveryMove,
-                 "Debug: after every accepted move verify the frame and compare ΔE with a full recomputation (slow)");
+    app.add_flag("--search-rotation", o.lattice.searchRotation,
+                 "Also search the lattice rotation about the up axis");
+    app.add_flag(
+        "--check-moves", o.checkEveryMove,
+        "Debug: after every accepted move verify the frame and compare ΔE with a full recomputation (slow)");
 }
 
 // --- partition (paper §5) -------------------------------------------------------------------------
@@ -160,21 +173,25 @@ void PartitionCli::addTo(CLI::App& app) {
     app.add_option("-k,--candidates", o.candidateCount, "Candidate labels per triangle: its k nearest balls")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
-    app.add_option("--w-smoothness", o.smoothnessStart, "First w_smoothness of the fit schedule")->capture_default_str();
+    app.add_option("--w-smoothness", o.smoothnessStart, "First w_smoothness of the fit schedule")
+        ->capture_default_str();
     app.add_option("--w-smoothness-factor", o.smoothnessFactor,
                    "Multiply w_smoothness by this while a partition does not fit")
         ->capture_default_str();
     app.add_option("--w-smoothness-min", o.smoothnessMin, "The schedule bottoms out below this w_smoothness")
         ->capture_default_str();
     app.add_option("--w-saliency", o.saliencyWeight, "w_saliency")->capture_default_str();
-    app.add_option("--min-piece-area-mm2", o.minPieceAreaMm2, "Merge smaller pieces into a neighbour when it fits")
+    app.add_option("--min-piece-area-mm2", o.minPieceAreaMm2,
+                   "Merge smaller pieces into a neighbour when it fits")
         ->capture_default_str();
     app.add_option("--svm-cost", o.svm.cost, "liblinear C for the planar cuts")->capture_default_str();
     app.add_option("--svm-samples", o.svmMaxSamples, "Train the planar cuts on at most this many faces")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
-    app.add_flag("--one-vs-rest", isOneVsRest, "One-vs-rest SVMs instead of Crammer-Singer (both give argmax cells)");
-    app.add_option("--graph-nodes", o.graphNodeTarget, "Cluster faces above this many graph-cut nodes (0 = never)")
+    app.add_flag("--one-vs-rest", isOneVsRest,
+                 "One-vs-rest SVMs instead of Crammer-Singer (both give argmax cells)");
+    app.add_option("--graph-nodes", o.graphNodeTarget,
+                   "Cluster faces above this many graph-cut nodes (0 = never)")
         ->capture_default_str();
 }
 
@@ -195,23 +212,30 @@ void PiecesCli::addTo(CLI::App& app) {
     pieces::PiecesOptions& o = options;
     app.add_option("--min-piece-volume-mm3", o.minPieceVolumeMm3, "Merge smaller pieces into a neighbour")
         ->capture_default_str();
-    app.add_option("--adaptivity", o.adaptivity, "Meshing: 0 = uniform triangles; up to 1 merges flat regions")
+    app.add_option("--adaptivity", o.adaptivity,
+                   "Meshing: 0 = uniform triangles; up to 1 merges flat regions")
         ->capture_default_str();
     app.add_option("--min-tenons", o.tenons.minPerPiece, "Tenons wanted per piece (fewer are reported)")
         ->capture_default_str();
-    app.add_option("--max-tenons", o.tenons.maxPerPiece, "Most tenons per piece (0 = none)")->capture_default_str();
+    app.add_option("--max-tenons", o.tenons.maxPerPiece, "Most tenons per piece (0 = none)")
+        ->capture_default_str();
     app.add_option("--tenon-clearance-mm", o.tenons.clearanceMm, "Gap between peg and hole on every side")
         ->capture_default_str();
-    app.add_option("--tenon-width-mm", o.tenons.bodyWidthMm, "Side of the square prism")->capture_default_str();
-    app.add_option("--peg-depth-mm", o.tenons.pegDepthMm, "How far the peg enters the blue hole")->capture_default_str();
+    app.add_option("--tenon-width-mm", o.tenons.bodyWidthMm, "Side of the square prism")
+        ->capture_default_str();
+    app.add_option("--peg-depth-mm", o.tenons.pegDepthMm, "How far the peg enters the blue hole")
+        ->capture_default_str();
     app.add_option("--tenon-max-length-mm", o.tenons.maxLengthMm, "Longest prism, ball face to inner surface")
         ->capture_default_str();
-    app.add_option("--tenon-max-tilt-deg", o.tenons.maxTiltDeg, "Largest angle between hole axis and surface normal")
+    app.add_option("--tenon-max-tilt-deg", o.tenons.maxTiltDeg,
+                   "Largest angle between hole axis and surface normal")
         ->capture_default_str();
-    app.add_flag("--tenon-lattice-holes-only", o.tenons.latticeHolesOnly,
-                 "Tenons only along the lattice axes (+-x +-y +-z), as the paper; default: all 30 blue holes");
+    app.add_flag(
+        "--tenon-lattice-holes-only", o.tenons.latticeHolesOnly,
+        "Tenons only along the lattice axes (+-x +-y +-z), as the paper; default: all 30 blue holes");
     app.add_flag("--no-label", isUnlabelled, "Do not engrave piece numbers");
-    app.add_option("--label-height-mm", o.label.heightMm, "Height of the engraved digits")->capture_default_str();
+    app.add_option("--label-height-mm", o.label.heightMm, "Height of the engraved digits")
+        ->capture_default_str();
     app.add_option("--label-depth-mm", o.label.depthMm, "Engraving depth")->capture_default_str();
 }
 
@@ -226,13 +250,16 @@ pieces::PiecesOptions PiecesCli::resolve() const {
 
 void CostCli::addTo(CLI::App& app) {
     report::CostOptions& cost = options;
-    app.add_option("--slicer", slicer,
-                   "Print times and filament from: estimator (built in) or prusa-slicer (runs it on every part)")
+    app.add_option(
+           "--slicer", slicer,
+           "Print times and filament from: estimator (built in) or prusa-slicer (runs it on every part)")
         ->capture_default_str()
         ->check(CLI::IsMember({"estimator", "prusa-slicer"}));
     app.add_option("--filament-mm", cost.filament.diameterMm, "Filament diameter")->capture_default_str();
-    app.add_option("--filament-g-per-cm3", cost.filament.densityGPerCm3, "Filament density")->capture_default_str();
-    app.add_option("--filament-usd-per-m", cost.filament.usdPerM, "Filament price per metre")->capture_default_str();
+    app.add_option("--filament-g-per-cm3", cost.filament.densityGPerCm3, "Filament density")
+        ->capture_default_str();
+    app.add_option("--filament-usd-per-m", cost.filament.usdPerM, "Filament price per metre")
+        ->capture_default_str();
     app.add_option("--strut-usd", cost.prices.strutUsd, "Price of one Zometool strut")->capture_default_str();
     app.add_option("--ball-usd", cost.prices.ballUsd, "Price of one Zometool ball")->capture_default_str();
 }
@@ -247,7 +274,8 @@ report::CostOptions CostCli::resolve() const {
 // --- preview --------------------------------------------------------------------------------------
 
 void PreviewCli::addTo(CLI::App& app) {
-    app.add_flag("--no-draco", isUncompressed, "Store the preview's pieces uncompressed (no KHR_draco_mesh_compression)");
+    app.add_flag("--no-draco", isUncompressed,
+                 "Store the preview's pieces uncompressed (no KHR_draco_mesh_compression)");
     app.add_option("--draco-bits", options.glb.dracoPositionBits, "Draco position quantisation, bits")
         ->capture_default_str()
         ->check(CLI::Range(8, 30));

@@ -32,7 +32,8 @@ partition::SalientSphere parseSalientSphere(const std::string& text);
 std::vector<uint32_t> readSalientFaceList(const std::string& path, size_t faceCount);
 
 /// A frame file (zomefab.structure JSON) and its transform_mm. @throw Error(InvalidInput) naming @p path
-zome::Structure readFrame(const std::string& path, Transform4d* transformMm = nullptr);
+zome::Structure readFrame(const std::string& path, Transform4d* transformMm = nullptr,
+                          const zome::ZomeScale& physical = {}, const zome::CollisionOptions& collision = {});
 
 /// A partition file (zomefab.partition JSON). @throw Error(InvalidInput) naming @p path
 partition::PartitionFile readPartition(const std::string& path);

@@ -30,27 +30,32 @@ json readJsonFile(const std::string& path) {
 }
 
 /// The `zomefab run` arguments of one entry's merged options.
-std::vector<std::string> runArguments(const json& options, const std::string& where, const std::string& path) {
+std::vector<std::string> runArguments(const json& options, const std::string& where,
+                                      const std::string& path) {
     std::vector<std::string> args;
     for (const auto& [key, value] : options.items()) {
         const std::string flag = "--" + key;
         if (value.is_boolean()) {
             if (value.get<bool>()) args.push_back(flag);
         } else if (value.is_array()) {
-            for (const json& v : value) args.insert(args.end(), {flag, v.is_string() ? v.get<std::string>() : v.dump()});
+            for (const json& v : value)
+                args.insert(args.end(), {flag, v.is_string() ? v.get<std::string>() : v.dump()});
         } else if (value.is_string() || value.is_number()) {
             args.insert(args.end(), {flag, value.is_string() ? value.get<std::string>() : value.dump()});
         } else {
-            throw Error(ErrorCode::InvalidInput, where + ": option \"" + key + "\" must be a string, number, boolean or list",
-                        path);
+            throw Error(ErrorCode::InvalidInput,
+                        where + ": option \"" + key + "\" must be a string, number, boolean or list", path);
         }
     }
     return args;
 }
 
-BatchEntry readEntry(const json& e, size_t index, const json& defaults, const fs::path& base, const std::string& path) {
+BatchEntry readEntry(const json& e, size_t index, const json& defaults, const fs::path& base,
+                     const std::string& path) {
     const std::string where = "entry " + std::to_string(index);
-    auto fail = [&](const std::string& what) { throw Error(ErrorCode::InvalidInput, where + ": " + what, path); };
+    auto fail = [&](const std::string& what) {
+        throw Error(ErrorCode::InvalidInput, where + ": " + what, path);
+    };
     if (!e.is_object() || !e.contains("mesh") || !e["mesh"].is_string()) fail("needs \"mesh\"");
     BatchEntry entry;
     const fs::path mesh(e["mesh"].get<std::string>());
@@ -90,7 +95,8 @@ std::vector<BatchEntry> readManifest(const std::string& path) {
     auto fail = [&](const std::string& what) { throw Error(ErrorCode::InvalidInput, what, path); };
     if (!manifest.is_object() || manifest.value("format", "") != kManifestFormatName)
         fail("not a batch manifest (expected \"format\": \"zomefab.batch\")");
-    if (!manifest.contains("version") || manifest["version"] != 1) fail("unsupported manifest version (expected 1)");
+    if (!manifest.contains("version") || manifest["version"] != 1)
+        fail("unsupported manifest version (expected 1)");
     const json defaults = manifest.contains("defaults") ? manifest["defaults"] : json::object();
     if (!defaults.is_object()) fail("\"defaults\" must be an object of run options");
     if (!manifest.contains("entries") || !manifest["entries"].is_array() || manifest["entries"].empty())
@@ -119,7 +125,8 @@ json runEntry(const WorkerCommand& command, const std::vector<BatchEntry>& entri
     process.context = &context;
     const int code = runProcess(args, process);
     const json row = entrySummary(entry, code, clock.seconds(), outDir);
-    writeOutputAtomic(outDir + "/" + entry.name + ".summary.json", [&](std::ostream& out) { out << row.dump(2) << '\n'; });
+    writeOutputAtomic(outDir + "/" + entry.name + ".summary.json",
+                      [&](std::ostream& out) { out << row.dump(2) << '\n'; });
     if (code != 0) context.warn(entry.name + ": failed with exit code " + std::to_string(code));
     return row;
 }
@@ -129,13 +136,15 @@ std::string summaryTable(const json& rows) {
     out << "| input | status | seconds | peak MB | balls | struts | pieces | material saved |\n"
         << "|---|---|---:|---:|---:|---:|---:|---:|\n";
     for (const json& r : rows) {
-        const std::string saved = r.contains("material_saved_percent")
-                                      ? std::to_string(int(r["material_saved_percent"].get<double>() + 0.5)) + "%"
-                                      : "–";
+        const std::string saved =
+            r.contains("material_saved_percent")
+                ? std::to_string(int(r["material_saved_percent"].get<double>() + 0.5)) + "%"
+                : "–";
         out << "| " << r["name"].get<std::string>() << " | " << r["status"].get<std::string>() << " | "
             << formatNumbers("%.1f", r["seconds"].get<double>()) << " | "
-            << formatNumbers("%.0f", r.value("peak_rss_bytes", 0.0) / 1048576.0) << " | " << r.value("balls", 0) << " | "
-            << r.value("struts", 0) << " | " << r.value("pieces", 0) << " | " << saved << " |\n";
+            << formatNumbers("%.0f", r.value("peak_rss_bytes", 0.0) / 1048576.0) << " | "
+            << r.value("balls", 0) << " | " << r.value("struts", 0) << " | " << r.value("pieces", 0) << " | "
+            << saved << " |\n";
     }
     return out.str();
 }
@@ -144,10 +153,14 @@ json mergeSummaries(const std::vector<BatchEntry>& entries, const std::string& o
     json rows = json::array();
     for (const BatchEntry& entry : entries) {
         const std::string path = outDir + "/" + entry.name + ".summary.json";
-        if (fs::exists(path)) rows.push_back(readJsonFile(path));
-        else rows.push_back({{"name", entry.name}, {"mesh", entry.mesh}, {"status", "missing"}, {"seconds", 0.0}});
+        if (fs::exists(path))
+            rows.push_back(readJsonFile(path));
+        else
+            rows.push_back(
+                {{"name", entry.name}, {"mesh", entry.mesh}, {"status", "missing"}, {"seconds", 0.0}});
     }
-    const json summary{{"format", kSummaryFormatName}, {"version", 1}, {"generator", generatorString()}, {"entries", rows}};
+    const json summary{
+        {"format", kSummaryFormatName}, {"version", 1}, {"generator", generatorString()}, {"entries", rows}};
     writeOutputAtomic(outDir + "/summary.json", [&](std::ostream& out) { out << summary.dump(2) << '\n'; });
     const std::string table = summaryTable(rows);
     writeOutputAtomic(outDir + "/summary.md", [&](std::ostream& out) { out << table; });
@@ -162,8 +175,16 @@ json runBench(const WorkerCommand& command, const BenchOptions& options, RunCont
         for (const double height : options.heightsMm) {
             const std::string heightText = formatNumber(height);
             const std::string out = (scratch / (fs::path(mesh).stem().string() + "-" + heightText)).string();
-            std::vector<std::string> args{command.executable, "run", (fs::path(options.dataDir) / mesh).string(), "-o", out,
-                                          "--up", options.up, "--height-mm", heightText, "-q"};
+            std::vector<std::string> args{command.executable,
+                                          "run",
+                                          (fs::path(options.dataDir) / mesh).string(),
+                                          "-o",
+                                          out,
+                                          "--up",
+                                          options.up,
+                                          "--height-mm",
+                                          heightText,
+                                          "-q"};
             args.insert(args.end(), command.sharedArgs.begin(), command.sharedArgs.end());
             args.insert(args.end(), options.extraArgs.begin(), options.extraArgs.end());
             context.info("bench: " + mesh + " at " + heightText + " mm");
@@ -172,10 +193,14 @@ json runBench(const WorkerCommand& command, const BenchOptions& options, RunCont
             process.searchPath = false;
             process.context = &context;
             const int code = runProcess(args, process);
-            json row{{"mesh", mesh}, {"height_mm", height}, {"exit_code", code}, {"wall_seconds", clock.seconds()}};
+            json row{{"mesh", mesh},
+                     {"height_mm", height},
+                     {"exit_code", code},
+                     {"wall_seconds", clock.seconds()}};
             if (code == 0) {
                 const json runReport = readJsonFile(out + "/report.json");
-                for (const char* key : {"timings", "peak_rss_bytes", "level_sets", "frame", "partition", "pieces", "cost"})
+                for (const char* key :
+                     {"timings", "peak_rss_bytes", "level_sets", "frame", "partition", "pieces", "cost"})
                     if (runReport.contains(key)) row[key] = runReport[key];
             }
             cases.push_back(row);
@@ -183,8 +208,11 @@ json runBench(const WorkerCommand& command, const BenchOptions& options, RunCont
     }
     std::error_code ec;
     fs::remove_all(scratch, ec);
-    return {{"format", "zomefab.bench"}, {"version", 1}, {"generator", generatorString()},
-            {"hardware_concurrency", std::thread::hardware_concurrency()}, {"cases", cases}};
+    return {{"format", "zomefab.bench"},
+            {"version", 1},
+            {"generator", generatorString()},
+            {"hardware_concurrency", std::thread::hardware_concurrency()},
+            {"cases", cases}};
 }
 
 }  // namespace zomefab::batch

@@ -19,7 +19,7 @@ inline constexpr const char* kSummaryFormatName = "zomefab.batch-summary";
 /// arguments its options stand for ({"height-mm": 400, "up": "y"} → --height-mm 400 --up y).
 struct BatchEntry {
     std::string name;
-    std::string mesh;                  ///< relative paths are taken from the manifest's directory
+    std::string mesh;  ///< relative paths are taken from the manifest's directory
     std::vector<std::string> runArgs;
 };
 

@@ -12,7 +12,9 @@ namespace zomefab {
 
 class DisjointSets {
 public:
-    explicit DisjointSets(size_t n = 0) : mParent(n) { std::iota(mParent.begin(), mParent.end(), uint32_t(0)); }
+    explicit DisjointSets(size_t n = 0) : mParent(n) {
+        std::iota(mParent.begin(), mParent.end(), uint32_t(0));
+    }
 
     size_t size() const { return mParent.size(); }
     uint32_t find(uint32_t x) {
@@ -23,8 +25,10 @@ public:
     void unite(uint32_t a, uint32_t b) {
         a = find(a), b = find(b);
         if (a == b) return;
-        if (a < b) mParent[b] = a;
-        else mParent[a] = b;
+        if (a < b)
+            mParent[b] = a;
+        else
+            mParent[a] = b;
     }
 
 private:

@@ -12,8 +12,9 @@ namespace zomefab {
 
 uint64_t seedFor(const Fabrication& fabrication, SeedStream stream) {
     switch (stream) {
-    case SeedStream::Frame:
-    case SeedStream::Partition: return fabrication.seed;
+        case SeedStream::Frame:
+        case SeedStream::Partition:
+            return fabrication.seed;
     }
     return fabrication.seed;
 }
@@ -31,8 +32,9 @@ void requireRange(double value, double lo, double hi, const char* option, const 
 void checkFabrication(const Fabrication& f) {
     for (double side : f.printerMm)
         if (!(side > 0.0) || !std::isfinite(side) || side > 10000.0)
-            throw Error(ErrorCode::Usage, "--printer-mm: every side must be in (0, 10000] mm, got " +
-                                              formatNumbers("%g x %g x %g", f.printerMm[0], f.printerMm[1], f.printerMm[2]));
+            throw Error(ErrorCode::Usage,
+                        "--printer-mm: every side must be in (0, 10000] mm, got " +
+                            formatNumbers("%g x %g x %g", f.printerMm[0], f.printerMm[1], f.printerMm[2]));
     requireRange(f.fitMarginMm, 0.0, 100.0, "--fit-margin-mm", "mm");
     requireRange(f.wallMm, 1.0, 200.0, "--shell-mm", "mm");
     requireRange(f.frameClearanceMm, 0.0, 1000.0, "--frame-clearance-mm", "mm");

@@ -52,6 +52,7 @@ void checkFabrication(const Fabrication& fabrication);
 /// Does a box of sides @p sizeMm, each grown by 2 · @p marginMm, fit @p printerMm after some
 /// permutation of its axes? Sorted sides against sorted sides decide it (the best of the six
 /// permutations); @p toleranceMm absorbs rounding. The one "box fits the printer" test.
-bool boxFitsPrinter(const Vec3d& sizeMm, const Vec3d& printerMm, double marginMm = 0.0, double toleranceMm = 0.0);
+bool boxFitsPrinter(const Vec3d& sizeMm, const Vec3d& printerMm, double marginMm = 0.0,
+                    double toleranceMm = 0.0);
 
 }  // namespace zomefab

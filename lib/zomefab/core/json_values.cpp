@@ -27,12 +27,14 @@ double numberFromJson(const json& j, const std::string& what) {
 }
 
 Vec3d vec3FromJson(const json& j, const std::string& what) {
-    if (!j.is_array() || j.size() != 3) throw Error(ErrorCode::InvalidInput, what + " must be an array of 3 numbers");
+    if (!j.is_array() || j.size() != 3)
+        throw Error(ErrorCode::InvalidInput, what + " must be an array of 3 numbers");
     return {numberFromJson(j[0], what), numberFromJson(j[1], what), numberFromJson(j[2], what)};
 }
 
 Box3d boxFromJson(const json& j, const std::string& what) {
-    if (!j.is_object()) throw Error(ErrorCode::InvalidInput, what + " must be an object with \"min\" and \"max\"");
+    if (!j.is_object())
+        throw Error(ErrorCode::InvalidInput, what + " must be an object with \"min\" and \"max\"");
     Box3d box;
     box.min = vec3FromJson(requireMember(j, "min", what), what + ".min");
     box.max = vec3FromJson(requireMember(j, "max", what), what + ".max");
@@ -40,7 +42,8 @@ Box3d boxFromJson(const json& j, const std::string& what) {
 }
 
 Transform4d transformFromJson(const json& j, const std::string& what) {
-    if (!j.is_array() || j.size() != 4) throw Error(ErrorCode::InvalidInput, what + " must be a 4x4 array of rows");
+    if (!j.is_array() || j.size() != 4)
+        throw Error(ErrorCode::InvalidInput, what + " must be a 4x4 array of rows");
     Transform4d t;
     for (size_t r = 0; r < 4; ++r) {
         if (!j[r].is_array() || j[r].size() != 4)

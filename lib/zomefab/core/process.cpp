@@ -32,7 +32,8 @@ int waitFor(pid_t pid, const RunContext* context, const std::string& name) {
         const pid_t r = ::waitpid(pid, &status, context ? WNOHANG : 0);
         if (r == pid) return exitCodeOf(status);
         if (r < 0 && errno != EINTR)
-            throw Error(ErrorCode::ProcessingFailed, "lost the process '" + name + "': " + std::strerror(errno));
+            throw Error(ErrorCode::ProcessingFailed,
+                        "lost the process '" + name + "': " + std::strerror(errno));
         if (context && context->isCancelled()) {
             ::kill(pid, SIGTERM);
             while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
@@ -54,7 +55,8 @@ int runProcess(const std::vector<std::string>& args, const ProcessOptions& optio
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     if (!options.outputPath.empty()) {
-        posix_spawn_file_actions_addopen(&actions, 1, options.outputPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        posix_spawn_file_actions_addopen(&actions, 1, options.outputPath.c_str(),
+                                         O_WRONLY | O_CREAT | O_TRUNC, 0644);
         posix_spawn_file_actions_adddup2(&actions, 1, 2);
     }
     posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);

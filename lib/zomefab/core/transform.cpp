@@ -23,7 +23,8 @@ Transform4d Transform4d::yUpToZUp() {
 
 Vec3d Transform4d::apply(const Vec3d& p) const {
     Vec3d r;
-    for (int i = 0; i < 3; ++i) r[i] = m[i * 4] * p[0] + m[i * 4 + 1] * p[1] + m[i * 4 + 2] * p[2] + m[i * 4 + 3];
+    for (int i = 0; i < 3; ++i)
+        r[i] = m[i * 4] * p[0] + m[i * 4 + 1] * p[1] + m[i * 4 + 2] * p[2] + m[i * 4 + 3];
     return r;
 }
 

@@ -124,7 +124,8 @@ size_t keepComponents(TriMesh& mesh, const VertexComponents& components,
         Triangle t = mesh.triangles[i];
         if (verdict[components.rootOf[t[0]]] == 0) continue;
         for (uint32_t& v : t) {
-            if (index[v] == kUnused) index[v] = uint32_t(kept.positions.size()), kept.positions.push_back(mesh.positions[v]);
+            if (index[v] == kUnused)
+                index[v] = uint32_t(kept.positions.size()), kept.positions.push_back(mesh.positions[v]);
             v = index[v];
         }
         kept.triangles.push_back(t);

@@ -57,8 +57,8 @@ FrameMetrics measureFrame(const zome::Structure& s, const FrameField& field, dou
     }
     for (zome::StrutId id : s.strutIds()) {
         const zome::Strut& st = s.strut(id);
-        m.minStrutClearanceMm = std::min(
-            m.minStrutClearanceMm, strutMinDepthMm(st, s, field) - s.scale().strutRadiusMm(st.color));
+        m.minStrutClearanceMm = std::min(m.minStrutClearanceMm,
+                                         strutMinDepthMm(st, s, field) - s.scale().strutRadiusMm(st.color));
     }
     m.minClearanceMm = std::min(m.minBallClearanceMm, m.minStrutClearanceMm);
 
@@ -166,8 +166,8 @@ LatticeOptions latticeOptionsFor(const Fabrication& fabrication, const LatticeOp
     return o;
 }
 
-FrameResult buildFrame(const sdf::InteriorField& field, const Fabrication& fabrication, const FrameOptions& options,
-                       RunContext& context) {
+FrameResult buildFrame(const sdf::InteriorField& field, const Fabrication& fabrication,
+                       const FrameOptions& options, RunContext& context) {
     checkFabrication(fabrication);
     const Stopwatch total;
     FrameResult r;
@@ -204,8 +204,8 @@ FrameResult buildFrame(const sdf::InteriorField& field, const Fabrication& fabri
         };
     }
     clock = Stopwatch();
-    std::vector<ChainResult> chains = annealChains(r.lattice.structure, ff, r.energyOptions, anneal,
-                                                   options.chains, r.seed, context);
+    std::vector<ChainResult> chains =
+        annealChains(r.lattice.structure, ff, r.energyOptions, anneal, options.chains, r.seed, context);
     r.annealSeconds = clock.seconds();
     r.bestChain = bestChain(chains);
     for (const ChainResult& c : chains) {
@@ -223,8 +223,8 @@ Transform4d frameTransformMm(const Transform4d& fieldTransformMm, double rotatio
     return rotationAboutZ(-rotationDeg) * fieldTransformMm;
 }
 
-nlohmann::json frameReportJson(const FrameResult& r, const FrameOptions& o,
-                               const FrameMetrics& before, const FrameMetrics& after) {
+nlohmann::json frameReportJson(const FrameResult& r, const FrameOptions& o, const FrameMetrics& before,
+                               const FrameMetrics& after) {
     uint64_t iterations = 0, feasible = 0;
     nlohmann::json chains = nlohmann::json::array();
     for (size_t c = 0; c < r.chains.size(); ++c) {
@@ -236,52 +236,54 @@ nlohmann::json frameReportJson(const FrameResult& r, const FrameOptions& o,
     }
     const EnergyOptions& e = r.energyOptions;
     const AnnealOptions& a = o.anneal;
-    return {
-        {"options",
-         {{"weights", {{"fidelity", e.fidelityWeight}, {"regularity", e.regularityWeight},
-                       {"valence", e.valenceWeight}, {"simplicity", e.simplicityWeight}}},
-          {"target_valence", e.targetValence},
-          {"valence_on_internal_only", e.valenceOnInternalOnly},
-          {"d_min_mm", r.zone.dMinMm},
-          {"d_max_mm", r.zone.dMaxMm},
-          {"f_thick", r.zone.fThick},
-          {"f_max", r.zone.fMax},
-          {"b0_mm", r.structure.scale().b0Mm},
-          {"t_init", a.initialTemperature},
-          {"cooling_factor", a.coolingFactor},
-          {"cooling_interval", a.coolingIntervalIterations},
-          {"t_end", a.finalTemperature},
-          {"max_iterations", a.maxIterations},
-          {"time_limit_s", a.timeLimitSeconds},
-          {"chains", o.chains},
-          {"seed", r.seed}}},
-        {"lattice",
-         {{"rotation_deg", r.lattice.rotationDeg},
-          {"offset_mm", r.lattice.offsetMm},
-          {"placements_tried", r.lattice.placementsTried},
-          {"cubes", r.lattice.cubes},
-          {"kept_cubes", r.lattice.keptCubes},
-          {"first_placement_cubes", r.lattice.firstPlacementCubes},
-          {"seconds", r.latticeSeconds}}},
-        {"target_count",
-         {{"tau", r.target.targetItemCount},
-          {"run_items", r.target.runItems},
-          {"run_coverage", r.target.runCoverage},
-          {"initial_coverage", r.target.initialCoverage},
-          {"surface_samples", r.target.surfaceSamples},
-          {"reachable_samples", r.target.reachableSamples},
-          {"seconds", r.targetSeconds}}},
-        {"energy_before", energyToJson(r.initialEnergy)},
-        {"energy_after", energyToJson(r.finalEnergy)},
-        {"best_chain", r.bestChain},
-        {"chains", chains},
-        {"iterations", iterations},
-        {"feasible_proposals", feasible},
-        {"anneal_seconds", r.annealSeconds},
-        {"iterations_per_second", r.annealSeconds > 0 ? double(iterations) / r.annealSeconds : 0.0},
-        {"run_seconds", r.totalSeconds},
-        {"initial_frame", metricsToJson(before)},
-        {"frame", metricsToJson(after)}};
+    return {{"options",
+             {{"weights",
+               {{"fidelity", e.fidelityWeight},
+                {"regularity", e.regularityWeight},
+                {"valence", e.valenceWeight},
+                {"simplicity", e.simplicityWeight}}},
+              {"target_valence", e.targetValence},
+              {"valence_on_internal_only", e.valenceOnInternalOnly},
+              {"d_min_mm", r.zone.dMinMm},
+              {"d_max_mm", r.zone.dMaxMm},
+              {"f_thick", r.zone.fThick},
+              {"f_max", r.zone.fMax},
+              {"b0_mm", r.structure.scale().b0Mm},
+              {"t_init", a.initialTemperature},
+              {"cooling_factor", a.coolingFactor},
+              {"cooling_interval", a.coolingIntervalIterations},
+              {"t_end", a.finalTemperature},
+              {"max_iterations", a.maxIterations},
+              {"time_limit_s", a.timeLimitSeconds},
+              {"chains", o.chains},
+              {"seed", r.seed}}},
+            {"lattice",
+             {{"rotation_deg", r.lattice.rotationDeg},
+              {"offset_mm", r.lattice.offsetMm},
+              {"placements_tried", r.lattice.placementsTried},
+              {"cubes", r.lattice.cubes},
+              {"kept_cubes", r.lattice.keptCubes},
+              {"first_placement_cubes", r.lattice.firstPlacementCubes},
+              {"seconds", r.latticeSeconds}}},
+            {"target_count",
+             {{"tau", r.target.targetItemCount},
+              {"run_items", r.target.runItems},
+              {"run_coverage", r.target.runCoverage},
+              {"initial_coverage", r.target.initialCoverage},
+              {"surface_samples", r.target.surfaceSamples},
+              {"reachable_samples", r.target.reachableSamples},
+              {"seconds", r.targetSeconds}}},
+            {"energy_before", energyToJson(r.initialEnergy)},
+            {"energy_after", energyToJson(r.finalEnergy)},
+            {"best_chain", r.bestChain},
+            {"chains", chains},
+            {"iterations", iterations},
+            {"feasible_proposals", feasible},
+            {"anneal_seconds", r.annealSeconds},
+            {"iterations_per_second", r.annealSeconds > 0 ? double(iterations) / r.annealSeconds : 0.0},
+            {"run_seconds", r.totalSeconds},
+            {"initial_frame", metricsToJson(before)},
+            {"frame", metricsToJson(after)}};
 }
 
 }  // namespace zomefab::frame

@@ -27,9 +27,9 @@ struct FrameOptions {
     /// Offset/rotation search and the kit's physical sizes. Its scale.b0Mm and zone.dMinMm /
     /// zone.dMaxMm come from the Fabrication (latticeOptionsFor); what is set here is replaced.
     LatticeOptions lattice;
-    EnergyOptions energy;        ///< weights; targetItemCount is replaced by the τ estimate
-    TargetCountOptions target;   ///< how τ is estimated (or fixed)
-    AnnealOptions anneal;        ///< cooling schedule and budgets
+    EnergyOptions energy;       ///< weights; targetItemCount is replaced by the τ estimate
+    TargetCountOptions target;  ///< how τ is estimated (or fixed)
+    AnnealOptions anneal;       ///< cooling schedule and budgets
     /// Independent annealing chains run in parallel; the best is kept. 8: on the demo bunny at 400 mm
     /// the best of 8 has E = 117.5 against 126.4 for one chain, in 0.08 s on 2 cores (32: 116.2).
     int chains = 8;
@@ -60,8 +60,7 @@ struct FrameMetrics {
     size_t surfaceSamples = 0;
 };
 
-FrameMetrics measureFrame(const zome::Structure& structure, const FrameField& field,
-                          double sampleSpacingMm);
+FrameMetrics measureFrame(const zome::Structure& structure, const FrameField& field, double sampleSpacingMm);
 nlohmann::json metricsToJson(const FrameMetrics& metrics);
 
 /// Every violated invariant of a frame, one line each (empty = valid): struts exact catalogue
@@ -70,13 +69,13 @@ nlohmann::json metricsToJson(const FrameMetrics& metrics);
 std::vector<std::string> verifyFrame(const zome::Structure& structure, const FrameField& field);
 
 struct FrameResult {
-    zome::Structure structure;         ///< the best chain's frame, ids compacted
-    sdf::ForbiddenZoneOptions zone;    ///< the forbidden zone it was built in (from the Fabrication)
-    uint64_t seed = 0;                 ///< seedFor(fabrication, SeedStream::Frame)
-    double rotationDeg = 0;            ///< lattice rotation about z
-    LatticeResult lattice;             ///< the initial frame and the search statistics
-    TargetCountResult target;          ///< τ and the runs it came from
-    EnergyOptions energyOptions;       ///< with τ filled in
+    zome::Structure structure;       ///< the best chain's frame, ids compacted
+    sdf::ForbiddenZoneOptions zone;  ///< the forbidden zone it was built in (from the Fabrication)
+    uint64_t seed = 0;               ///< seedFor(fabrication, SeedStream::Frame)
+    double rotationDeg = 0;          ///< lattice rotation about z
+    LatticeResult lattice;           ///< the initial frame and the search statistics
+    TargetCountResult target;        ///< τ and the runs it came from
+    EnergyOptions energyOptions;     ///< with τ filled in
     EnergyTerms initialEnergy;
     EnergyTerms finalEnergy;
     std::vector<ChainStats> chains;
@@ -92,8 +91,8 @@ LatticeOptions latticeOptionsFor(const Fabrication& fabrication, const LatticeOp
 /// The frame stage. @p field is the object's "interior" field in mm (z up).
 /// @throw Error(ProcessingFailed) when the object is too thin for one cube; Error(Usage) for
 ///        invalid options; Error(Cancelled).
-FrameResult buildFrame(const sdf::InteriorField& field, const Fabrication& fabrication, const FrameOptions& options,
-                       RunContext& context);
+FrameResult buildFrame(const sdf::InteriorField& field, const Fabrication& fabrication,
+                       const FrameOptions& options, RunContext& context);
 
 /// transform_mm of the frame file: the field's transform_mm (input mesh → field mm) followed by
 /// the lattice rotation R(−rotationDeg) (field mm → frame mm).

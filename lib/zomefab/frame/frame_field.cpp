@@ -20,8 +20,8 @@ Transform4d rotationAboutZ(double degrees) {
     return t;
 }
 
-FrameField::FrameField(const sdf::InteriorField& field, double rotationDeg,
-                       const zome::ZomeScale& scale, const sdf::ForbiddenZoneOptions& zone)
+FrameField::FrameField(const sdf::InteriorField& field, double rotationDeg, const zome::ZomeScale& scale,
+                       const sdf::ForbiddenZoneOptions& zone)
     : mField(&field), mRotationDeg(rotationDeg), mScale(scale), mZone(zone) {
     const double a = rotationDeg * kPi / 180.0;
     mCos = std::cos(a);
@@ -62,8 +62,7 @@ std::vector<SurfaceSample> sampleSurface(const FrameField& frameField, double sp
                 const double g = norm(s.gradient);
                 if (!(g > 1e-9)) continue;
                 const Vec3d nrm{s.gradient[0] / g, s.gradient[1] / g, s.gradient[2] / g};
-                const Vec3d onSurface{p[0] - s.signedDistanceMm * nrm[0],
-                                      p[1] - s.signedDistanceMm * nrm[1],
+                const Vec3d onSurface{p[0] - s.signedDistanceMm * nrm[0], p[1] - s.signedDistanceMm * nrm[1],
                                       p[2] - s.signedDistanceMm * nrm[2]};
                 const Vec3d inward{onSurface[0] - reachMm * nrm[0], onSurface[1] - reachMm * nrm[1],
                                    onSurface[2] - reachMm * nrm[2]};

@@ -186,10 +186,16 @@ private:
     size_t mNext = 0;
 };
 
-}  // namespace
+/// A PLY header: its elements and format, and where the body starts.
+struct PlyHeader {
+    std::vector<PlyElement> elements;
+    PlyFormat format = PlyFormat::Ascii;
+    size_t bodyOffset = 0;
+    size_t lineCount = 0;  ///< lines of the header, for the body's line numbers
+};
 
-TriMesh parsePly(std::string_view bytes, const std::string& source) {
-    // ---- header: lines up to "end_header" ----
+/// The header: lines up to "end_header". @throw Error(InvalidInput) naming @p source and the line.
+PlyHeader parsePlyHeader(std::string_view bytes, const std::string& source) {
     size_t pos = 0;
     size_t lineNo = 0;
     auto nextLine = [&](std::string_view& line) -> bool {
@@ -271,6 +277,17 @@ TriMesh parsePly(std::string_view bytes, const std::string& source) {
     if (!haveEnd) fail(source, "PLY header has no 'end_header'");
     if (!haveFormat) fail(source, "PLY header has no 'format' line");
 
+    PlyHeader header{std::move(elements), format, pos, lineNo};
+    return header;
+}
+
+}  // namespace
+
+TriMesh parsePly(std::string_view bytes, const std::string& source) {
+    const PlyHeader header = parsePlyHeader(bytes, source);
+    const std::vector<PlyElement>& elements = header.elements;
+    const PlyFormat format = header.format;
+    const size_t pos = header.bodyOffset, lineNo = header.lineCount;
     // ---- which properties we use ----
     const PlyElement* vertexElement = nullptr;
     const PlyElement* faceElement = nullptr;

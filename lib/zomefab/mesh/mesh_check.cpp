@@ -260,11 +260,19 @@ MeshReport checkMesh(const TriMesh& mesh) {
     return r;
 }
 
-TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const std::string& sourceName,
-                           RunContext& context) {
-    auto fail = [&](const std::string& message) {
+namespace {
+
+/// Throws Error(InvalidInput) naming the mesh's file.
+struct Failure {
+    const std::string& sourceName;
+    [[noreturn]] void operator()(const std::string& message) const {
         throw Error(ErrorCode::InvalidInput, message, sourceName);
-    };
+    }
+};
+
+/// Rejects an empty mesh, indices out of range, mismatched salient flags and non-finite coordinates.
+void checkBasics(const TriMesh& mesh, const std::string& sourceName) {
+    const Failure fail{sourceName};
     if (mesh.triangles.empty()) fail("no triangles");
     try {
         checkIndices(mesh);
@@ -280,9 +288,12 @@ TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const s
         if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
             fail("vertex " + std::to_string(v) + " has a non-finite coordinate (NaN or infinity)");
     }
-    context.throwIfCancelled();
+}
 
-    // Drop triangles with a repeated index (no area, no proper edges) and repeated triangles.
+/// Drops triangles with a repeated index (no area, no proper edges) and repeated triangles (warning).
+void dropDegenerate(TriMesh& mesh, const std::string& sourceName, const RunContext& context) {
+    const Failure fail{sourceName};
+    const bool hasSalient = !mesh.salientFaces.empty();
     {
         std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> keyed;
         keyed.reserve(mesh.triangles.size());
@@ -323,7 +334,10 @@ TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const s
             if (mesh.triangles.empty()) fail("no triangles left after dropping degenerate ones");
         }
     }
-    // Drop unreferenced vertices, keeping the order of the others.
+}
+
+/// Drops unreferenced vertices, keeping the order of the others.
+void dropUnreferenced(TriMesh& mesh, const std::string& sourceName, const RunContext& context) {
     {
         std::vector<uint32_t> remap(mesh.positions.size(), UINT32_MAX);
         for (const Triangle& t : mesh.triangles)
@@ -342,17 +356,11 @@ TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const s
             mesh.positions = std::move(kept);
         }
     }
-    context.throwIfCancelled();
+}
 
-    if (options.repair) {
-        const auto [holes, added] = fillHoles(mesh, options.maxHoleEdges, context);
-        if (holes > 0)
-            context.warn(sourceName + ": filled " + std::to_string(holes) +
-                         (holes == 1 ? " hole" : " holes") + " with " + std::to_string(added) + " triangles");
-    }
-
-    // Closed and manifold?
-    const std::vector<EdgeUse> uses = collectEdges(mesh);
+/// Rejects an open mesh (with the count, loops and box of its boundary edges) and non-manifold edges.
+void requireClosed(const TriMesh& mesh, const std::vector<EdgeUse>& uses, const std::string& sourceName) {
+    const Failure fail{sourceName};
     {
         size_t boundary = 0, nonManifold = 0;
         Box3d boundaryBox, nonManifoldBox;
@@ -386,9 +394,16 @@ TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const s
                  " edges shared by three or more triangles, between " + formatPoint(nonManifoldBox.min) +
                  " and " + formatPoint(nonManifoldBox.max));
     }
+}
 
-    // Consistent orientation: walk each component across its edges; two neighbours agree when
-    // they run their shared edge in opposite directions. A conflict means a non-orientable surface.
+/// Makes the orientation consistent within each component: walks each component across its
+/// edges; two neighbours agree when they run their shared edge in opposite directions (a
+/// conflict means a non-orientable surface). Keeps the majority of each component as it is and
+/// flips the minority. Returns the components (sorted triangle lists).
+std::vector<std::vector<uint32_t>> orientConsistently(TriMesh& mesh, const std::vector<EdgeUse>& uses,
+                                                      const std::string& sourceName,
+                                                      const RunContext& context) {
+    const Failure fail{sourceName};
     const size_t triangleCount = mesh.triangles.size();
     std::vector<uint32_t> neighbourStart(triangleCount + 1, 0);
     struct Link {
@@ -454,8 +469,13 @@ TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const s
                      " triangles to make the orientation consistent");
     context.throwIfCancelled();
 
-    // Outward: each component's volume must be positive, unless it lies inside an odd number of
-    // other components (then it bounds a cavity and must be negative).
+    return components;
+}
+
+/// Makes each component outward: its volume must be positive, unless it lies inside an odd number
+/// of other components (then it bounds a cavity and must be negative). Returns the volumes.
+std::vector<double> orientOutward(TriMesh& mesh, const std::vector<std::vector<uint32_t>>& components,
+                                  const std::string& sourceName, const RunContext& context) {
     const Box3d box = boundingBox(mesh);
     const Vec3d centre{(box.min[0] + box.max[0]) / 2, (box.min[1] + box.max[1]) / 2,
                        (box.min[2] + box.max[2]) / 2};
@@ -517,6 +537,31 @@ TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const s
                                 std::to_string(components.size()) +
                                 " components were inside out; flipped them"));
 
+    return volumes;
+}
+
+}  // namespace
+
+TriMesh validateClosedMesh(TriMesh mesh, const ValidateOptions& options, const std::string& sourceName,
+                           RunContext& context) {
+    checkBasics(mesh, sourceName);
+    context.throwIfCancelled();
+    dropDegenerate(mesh, sourceName, context);
+    dropUnreferenced(mesh, sourceName, context);
+    context.throwIfCancelled();
+    if (options.repair) {
+        const auto [holes, added] = fillHoles(mesh, options.maxHoleEdges, context);
+        if (holes > 0)
+            context.warn(sourceName + ": filled " + std::to_string(holes) +
+                         (holes == 1 ? " hole" : " holes") + " with " + std::to_string(added) + " triangles");
+    }
+    const std::vector<EdgeUse> uses = collectEdges(mesh);
+    requireClosed(mesh, uses, sourceName);
+    const std::vector<std::vector<uint32_t>> components = orientConsistently(mesh, uses, sourceName, context);
+    context.throwIfCancelled();
+    const std::vector<double> volumes = orientOutward(mesh, components, sourceName, context);
+    const Failure fail{sourceName};
+    const Box3d box = boundingBox(mesh);
     const double volume = std::accumulate(volumes.begin(), volumes.end(), 0.0);
     const Vec3d size = box.size();
     const double diagonal = std::sqrt(dot(size, size));
@@ -533,8 +578,10 @@ CavityRemoval removeCavities(TriMesh& mesh, double maxVolumeMm3) {
     };
     CavityRemoval removal;
     for (uint32_t v = 0; v < mesh.vertexCount(); ++v)
-        if (components.rootOf[v] == v && isSmallCavity(v)) ++removal.cavities, removal.volumeMm3 -= components.volume[v];
-    if (removal.cavities > 0) keepComponents(mesh, components, [&](uint32_t root) { return !isSmallCavity(root); });
+        if (components.rootOf[v] == v && isSmallCavity(v))
+            ++removal.cavities, removal.volumeMm3 -= components.volume[v];
+    if (removal.cavities > 0)
+        keepComponents(mesh, components, [&](uint32_t root) { return !isSmallCavity(root); });
     return removal;
 }
 

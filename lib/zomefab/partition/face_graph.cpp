@@ -21,18 +21,21 @@ FaceGraph buildFaceGraph(const TriMesh& meshMm) {
         for (uint32_t v : meshMm.triangles[f])
             if (v >= vertexCount)
                 throw Error(ErrorCode::InvalidInput, "triangle " + std::to_string(f) + " references vertex " +
-                                                         std::to_string(v) + " of " + std::to_string(vertexCount));
+                                                         std::to_string(v) + " of " +
+                                                         std::to_string(vertexCount));
 
     FaceGraph g;
     g.centroidsMm.resize(faceCount);
     g.normals.resize(faceCount);
     g.areasMm2.resize(faceCount);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, faceCount, 4096), [&](const tbb::blocked_range<size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, faceCount, 4096), [&](const tbb::blocked_range<size_t>&
+                                                                              r) {
         for (size_t f = r.begin(); f < r.end(); ++f) {
             const auto& t = meshMm.triangles[f];
             const Vec3d a = toD(meshMm.positions[t[0]]), b = toD(meshMm.positions[t[1]]),
                         c = toD(meshMm.positions[t[2]]);
-            g.centroidsMm[f] = {(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0, (a[2] + b[2] + c[2]) / 3.0};
+            g.centroidsMm[f] = {(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0,
+                                (a[2] + b[2] + c[2]) / 3.0};
             const Vec3d u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
             const Vec3d n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
             const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
@@ -44,16 +47,17 @@ FaceGraph buildFaceGraph(const TriMesh& meshMm) {
     // Every undirected edge as (min vertex, max vertex) → faces; (key, face) pairs are unique, so
     // the parallel sort gives the same order whatever the thread count.
     std::vector<std::pair<uint64_t, uint32_t>> edges(3 * faceCount);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, faceCount, 4096), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t f = r.begin(); f < r.end(); ++f) {
-            const auto& t = meshMm.triangles[f];
-            for (int e = 0; e < 3; ++e) {
-                uint64_t a = t[e], b = t[(e + 1) % 3];
-                if (a > b) std::swap(a, b);
-                edges[3 * f + e] = {(a << 32) | b, uint32_t(f)};
-            }
-        }
-    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, faceCount, 4096),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t f = r.begin(); f < r.end(); ++f) {
+                              const auto& t = meshMm.triangles[f];
+                              for (int e = 0; e < 3; ++e) {
+                                  uint64_t a = t[e], b = t[(e + 1) % 3];
+                                  if (a > b) std::swap(a, b);
+                                  edges[3 * f + e] = {(a << 32) | b, uint32_t(f)};
+                              }
+                          }
+                      });
     tbb::parallel_sort(edges.begin(), edges.end());
 
     std::vector<std::pair<uint32_t, uint32_t>> pairs;  // both directions

@@ -35,8 +35,8 @@ struct SalientSphere {
 
 struct PartitionOptions {
     // --- energy, Eq. (1)–(4) -----------------------------------------------------------------
-    double dataWeight = 1.0;       ///< w_data (paper: 1.0 for all shapes)
-    double saliencyWeight = 5.0;   ///< w_saliency (paper: 5.0)
+    double dataWeight = 1.0;      ///< w_data (paper: 1.0 for all shapes)
+    double saliencyWeight = 5.0;  ///< w_saliency (paper: 5.0)
     /// k: the candidate labels of a triangle are its k nearest label balls; every other label
     /// gets a prohibitive (infinite) data cost, so a piece always lies over balls near it.
     int candidateCount = 8;
@@ -47,8 +47,8 @@ struct PartitionOptions {
     double minDihedralRad = 1e-3;
 
     // --- fit schedule (§5.1) ------------------------------------------------------------------
-    double smoothnessStart = 10.0;   ///< first w_smoothness (paper: 10)
-    double smoothnessFactor = 0.1;   ///< w_smoothness *= this while a partition does not fit
+    double smoothnessStart = 10.0;  ///< first w_smoothness (paper: 10)
+    double smoothnessFactor = 0.1;  ///< w_smoothness *= this while a partition does not fit
     /// The schedule bottoms out when the next w_smoothness would fall below this; oversized
     /// partitions are then split (and the result says so).
     double smoothnessMin = 1e-3;
@@ -116,7 +116,7 @@ void checkPartitionOptions(const PartitionOptions& options, const Fabrication& f
 struct RegionMerge {
     std::vector<uint32_t> groupOf;  ///< per region: its group, numbered by lowest region
     uint32_t groupCount = 0;
-    size_t merges = 0;              ///< = region count − groupCount
+    size_t merges = 0;  ///< = region count − groupCount
 };
 
 /// Repeatedly merges a region of @p regionOf (per face, < @p regionCount; regions need not be
@@ -124,8 +124,9 @@ struct RegionMerge {
 /// @p marginMm (the schedule's fit test): the smallest region (by area, then id) that has a
 /// neighbour it fits with goes into the one of those with the longest shared seam (then lowest id);
 /// stops when no merge fits. Deterministic, whatever the thread count.
-RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph, const std::vector<uint32_t>& regionOf,
-                                uint32_t regionCount, const Vec3d& printerMm, double marginMm);
+RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph,
+                                const std::vector<uint32_t>& regionOf, uint32_t regionCount,
+                                const Vec3d& printerMm, double marginMm);
 
 /// Per-face flags: the mesh's salientFaces, faces within a sphere (closest point of the triangle
 /// within the radius) and the listed indices. @throw Error(Usage) for an index out of range.

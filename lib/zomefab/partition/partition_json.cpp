@@ -5,8 +5,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "zomefab/core/json_values.h"
 #include "zomefab/core/error.h"
+#include "zomefab/core/json_values.h"
 #include "zomefab/core/version.h"
 
 namespace zomefab::partition {
@@ -14,7 +14,6 @@ namespace zomefab::partition {
 using nlohmann::json;
 
 namespace {
-
 
 template <class T>
 void append(std::string& out, T value) {
@@ -37,30 +36,34 @@ json partitionToJson(const PartitionResult& r, const PartitionOptions& o, const 
     j["fit_margin_mm"] = r.fitMarginMm;
 
     json labels = json::array();
-    for (size_t l = 0; l < r.labelBalls.size(); ++l) labels.push_back({{"label", l}, {"ball", r.labelBalls[l]}});
+    for (size_t l = 0; l < r.labelBalls.size(); ++l)
+        labels.push_back({{"label", l}, {"ball", r.labelBalls[l]}});
     j["labels"] = labels;
 
     json cells = json::array();
     for (size_t c = 0; c < r.cells.cellCount(); ++c)
-        cells.push_back({{"cell", c}, {"ball", r.cellBalls[c]}, {"w", toJson(r.cells.w[c])}, {"b", r.cells.b[c]}});
+        cells.push_back(
+            {{"cell", c}, {"ball", r.cellBalls[c]}, {"w", toJson(r.cells.w[c])}, {"b", r.cells.b[c]}});
     j["cells"] = cells;
 
     json pieces = json::array();
     for (size_t p = 0; p < r.pieces.size(); ++p) {
         const Piece& piece = r.pieces[p];
-        json axes = json::array({toJson(piece.fit.axes[0]), toJson(piece.fit.axes[1]), toJson(piece.fit.axes[2])});
-        pieces.push_back({{"piece", p},
-                          {"cells", piece.cells},
-                          {"balls", piece.balls},
-                          {"faces", piece.faceCount},
-                          {"area_mm2", piece.areaMm2},
-                          {"bbox_mm", {{"min", toJson(piece.boundsMm.min)}, {"max", toJson(piece.boundsMm.max)}}},
-                          {"fit",
-                           {{"fits", piece.fit.fits},
-                            {"ratio", piece.fit.ratio},
-                            {"axes", axes},
-                            {"extents_mm", toJson(piece.fit.extentsMm)},
-                            {"center_mm", toJson(piece.fit.centerMm)}}}});
+        json axes =
+            json::array({toJson(piece.fit.axes[0]), toJson(piece.fit.axes[1]), toJson(piece.fit.axes[2])});
+        pieces.push_back(
+            {{"piece", p},
+             {"cells", piece.cells},
+             {"balls", piece.balls},
+             {"faces", piece.faceCount},
+             {"area_mm2", piece.areaMm2},
+             {"bbox_mm", {{"min", toJson(piece.boundsMm.min)}, {"max", toJson(piece.boundsMm.max)}}},
+             {"fit",
+              {{"fits", piece.fit.fits},
+               {"ratio", piece.fit.ratio},
+               {"axes", axes},
+               {"extents_mm", toJson(piece.fit.extentsMm)},
+               {"center_mm", toJson(piece.fit.centerMm)}}}});
     }
     j["pieces"] = pieces;
 
@@ -115,18 +118,20 @@ json partitionToJson(const PartitionResult& r, const PartitionOptions& o, const 
 json partitionSummaryJson(const PartitionResult& r) {
     double worst = 0.0;
     for (const Piece& p : r.pieces) worst = std::max(worst, p.fit.ratio);
-    return {{"faces", r.faceCells.size()},
-            {"labels", r.labelBalls.size()},
-            {"graph_nodes", r.graphNodes},
-            {"candidate_pairs", r.candidatePairs},
-            {"w_smoothness", r.smoothnessWeight},
-            {"energy_nearest_ball", r.energyNearest},
-            {"energy_graph_cut", r.energyGraphCut},
-            {"nearest_ball_partitions", r.nearestPartitions},
-            {"graph_cut_partitions", r.graphCutPartitions},
-            {"pieces", r.pieces.size()},
-            {"largest_fit_ratio", worst},
-            {"seconds", {{"graph_cut", r.secondsGraphCut}, {"svm_and_pieces", r.secondsSvm}, {"total", r.secondsTotal}}}};
+    return {
+        {"faces", r.faceCells.size()},
+        {"labels", r.labelBalls.size()},
+        {"graph_nodes", r.graphNodes},
+        {"candidate_pairs", r.candidatePairs},
+        {"w_smoothness", r.smoothnessWeight},
+        {"energy_nearest_ball", r.energyNearest},
+        {"energy_graph_cut", r.energyGraphCut},
+        {"nearest_ball_partitions", r.nearestPartitions},
+        {"graph_cut_partitions", r.graphCutPartitions},
+        {"pieces", r.pieces.size()},
+        {"largest_fit_ratio", worst},
+        {"seconds",
+         {{"graph_cut", r.secondsGraphCut}, {"svm_and_pieces", r.secondsSvm}, {"total", r.secondsTotal}}}};
 }
 
 const std::vector<uint32_t>& faceGroups(const PartitionResult& r, const std::string& groups) {
@@ -134,7 +139,8 @@ const std::vector<uint32_t>& faceGroups(const PartitionResult& r, const std::str
     if (groups == "cells") return r.faceCells;
     if (groups == "labels") return r.graphCutLabels;
     if (groups == "nearest") return r.nearestLabels;
-    throw Error(ErrorCode::Usage, "face groups must be pieces, cells, labels or nearest, got \"" + groups + "\"");
+    throw Error(ErrorCode::Usage,
+                "face groups must be pieces, cells, labels or nearest, got \"" + groups + "\"");
 }
 
 std::string coloredPlyBytes(const TriMesh& mesh, const std::vector<uint32_t>& groups) {
@@ -143,10 +149,13 @@ std::string coloredPlyBytes(const TriMesh& mesh, const std::vector<uint32_t>& gr
                                           std::to_string(mesh.triangles.size()) + " faces");
     std::string out =
         "ply\nformat binary_little_endian 1.0\ncomment zomefab partition: one colour per group\n"
-        "element vertex " + std::to_string(mesh.positions.size()) +
+        "element vertex " +
+        std::to_string(mesh.positions.size()) +
         "\nproperty float x\nproperty float y\nproperty float z\n"
-        "element face " + std::to_string(mesh.triangles.size()) +
-        "\nproperty list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+        "element face " +
+        std::to_string(mesh.triangles.size()) +
+        "\nproperty list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\nproperty uchar "
+        "blue\n"
         "property int group\nend_header\n";
     out.reserve(out.size() + mesh.positions.size() * 12 + mesh.triangles.size() * 20);
     for (const Vec3f& p : mesh.positions)
@@ -162,12 +171,24 @@ std::string coloredPlyBytes(const TriMesh& mesh, const std::vector<uint32_t>& gr
         const double p = v * (1 - s), q = v * (1 - s * fr), t = v * (1 - s * (1 - fr));
         double rgb[3];
         switch (i) {
-            case 0: rgb[0] = v, rgb[1] = t, rgb[2] = p; break;
-            case 1: rgb[0] = q, rgb[1] = v, rgb[2] = p; break;
-            case 2: rgb[0] = p, rgb[1] = v, rgb[2] = t; break;
-            case 3: rgb[0] = p, rgb[1] = q, rgb[2] = v; break;
-            case 4: rgb[0] = t, rgb[1] = p, rgb[2] = v; break;
-            default: rgb[0] = v, rgb[1] = p, rgb[2] = q; break;
+            case 0:
+                rgb[0] = v, rgb[1] = t, rgb[2] = p;
+                break;
+            case 1:
+                rgb[0] = q, rgb[1] = v, rgb[2] = p;
+                break;
+            case 2:
+                rgb[0] = p, rgb[1] = v, rgb[2] = t;
+                break;
+            case 3:
+                rgb[0] = p, rgb[1] = q, rgb[2] = v;
+                break;
+            case 4:
+                rgb[0] = t, rgb[1] = p, rgb[2] = v;
+                break;
+            default:
+                rgb[0] = v, rgb[1] = p, rgb[2] = q;
+                break;
         }
         for (double c : rgb) append<uint8_t>(out, uint8_t(std::lround(c * 255.0)));
         append<int32_t>(out, int32_t(groups[f]));

@@ -58,7 +58,8 @@ void readPieces(const json& pieces, PartitionResult& r) {
     for (size_t p = 0; p < pieces.size(); ++p) {
         const json& j = pieces[p];
         const std::string name = "piece " + std::to_string(p);
-        if (!j.is_object() || !j.contains("cells") || !j["cells"].is_array()) fail(name + ": needs \"cells\"");
+        if (!j.is_object() || !j.contains("cells") || !j["cells"].is_array())
+            fail(name + ": needs \"cells\"");
         Piece piece;
         for (const json& c : j["cells"]) {
             if (!c.is_number_unsigned() || c.get<size_t>() >= r.cells.cellCount())
@@ -70,7 +71,8 @@ void readPieces(const json& pieces, PartitionResult& r) {
         if (j.contains("area_mm2")) piece.areaMm2 = numberFromJson(j["area_mm2"], name + " area_mm2");
         if (j.contains("bbox_mm")) {
             const json& b = j["bbox_mm"];
-            if (!b.is_object() || !b.contains("min") || !b.contains("max")) fail(name + ": bbox_mm needs min and max");
+            if (!b.is_object() || !b.contains("min") || !b.contains("max"))
+                fail(name + ": bbox_mm needs min and max");
             piece.boundsMm.expand(vec3FromJson(b["min"], name + " bbox_mm.min"));
             piece.boundsMm.expand(vec3FromJson(b["max"], name + " bbox_mm.max"));
         }
@@ -81,10 +83,11 @@ void readPieces(const json& pieces, PartitionResult& r) {
 
 /// The per-face arrays, when present; all of one length.
 void readFaces(const json& j, PartitionResult& r) {
-    const std::pair<const char*, std::vector<uint32_t>*> arrays[] = {{"face_nearest_labels", &r.nearestLabels},
-                                                                     {"face_labels", &r.graphCutLabels},
-                                                                     {"face_cells", &r.faceCells},
-                                                                     {"face_pieces", &r.facePieces}};
+    const std::pair<const char*, std::vector<uint32_t>*> arrays[] = {
+        {"face_nearest_labels", &r.nearestLabels},
+        {"face_labels", &r.graphCutLabels},
+        {"face_cells", &r.faceCells},
+        {"face_pieces", &r.facePieces}};
     for (const auto& [key, target] : arrays)
         if (j.contains(key)) *target = indicesFromJson(j[key], key);
     for (uint32_t c : r.faceCells)
@@ -105,11 +108,13 @@ PartitionFile partitionFromJson(const json& j) {
     if (!j.is_object()) fail("invalid JSON");
     if (j.value("format", "") != kPartitionFormatName)
         fail(std::string("not a partition file (format is not \"") + kPartitionFormatName + "\")");
-    if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<int>() != kPartitionFormatVersion)
+    if (!j.contains("version") || !j["version"].is_number_integer() ||
+        j["version"].get<int>() != kPartitionFormatVersion)
         fail("unsupported partition file version (expected " + std::to_string(kPartitionFormatVersion) + ")");
     PartitionFile file;
     PartitionResult& r = file.result;
-    if (j.contains("transform_mm")) file.info.transformMm = transformFromJson(j["transform_mm"], "transform_mm");
+    if (j.contains("transform_mm"))
+        file.info.transformMm = transformFromJson(j["transform_mm"], "transform_mm");
     if (j.contains("mesh") && j["mesh"].is_object()) {
         file.info.meshFile = j["mesh"].value("file", "");
         file.info.vertexCount = j["mesh"].value("vertices", size_t(0));
@@ -121,7 +126,8 @@ PartitionFile partitionFromJson(const json& j) {
     if (j.contains("printer_mm")) r.printerMm = vec3FromJson(j["printer_mm"], "printer_mm");
     if (j.contains("fit_margin_mm")) r.fitMarginMm = numberFromJson(j["fit_margin_mm"], "fit_margin_mm");
     if (j.contains("labels") && j["labels"].is_array())
-        for (const json& l : j["labels"]) r.labelBalls.push_back(indexFromJson(requireMember(l, "ball", "labels"), "labels"));
+        for (const json& l : j["labels"])
+            r.labelBalls.push_back(indexFromJson(requireMember(l, "ball", "labels"), "labels"));
     readCells(requireMember(j, "cells", "partition file"), r);
     readPieces(requireMember(j, "pieces", "partition file"), r);
     readFaces(j, r);

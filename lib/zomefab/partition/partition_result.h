@@ -43,44 +43,44 @@ struct Piece {
     std::vector<zome::BallId> balls;  ///< the label balls of those cells
     uint32_t faceCount = 0;
     double areaMm2 = 0.0;
-    Box3d boundsMm;                   ///< axis-aligned box of its faces' vertices
-    PrinterFit fit;                   ///< best orientation in the printer
+    Box3d boundsMm;  ///< axis-aligned box of its faces' vertices
+    PrinterFit fit;  ///< best orientation in the printer
 };
 
 struct PartitionResult {
     double b0Mm = Fabrication{}.b0Mm;
     Vec3d printerMm = Fabrication{}.printerMm;  ///< the Fabrication's printer it was cut for
     double fitMarginMm = 0.0;
-    std::vector<zome::BallId> labelBalls;   ///< label index → ball id (the input N_out order)
-    std::vector<uint32_t> nearestLabels;    ///< per face: label of the nearest ball
-    std::vector<uint32_t> graphCutLabels;   ///< per face: label after the fit schedule (each region as
-                                            ///< the step that kept it cut it)
-    LinearCells cells;                      ///< argmax cells in mm
-    std::vector<zome::BallId> cellBalls;    ///< cell → the ball it attaches to
-    std::vector<uint32_t> faceCells;        ///< per face: the cell containing its centroid
-    std::vector<uint32_t> facePieces;       ///< per face: its piece
+    std::vector<zome::BallId> labelBalls;  ///< label index → ball id (the input N_out order)
+    std::vector<uint32_t> nearestLabels;   ///< per face: label of the nearest ball
+    std::vector<uint32_t> graphCutLabels;  ///< per face: label after the fit schedule (each region as
+                                           ///< the step that kept it cut it)
+    LinearCells cells;                     ///< argmax cells in mm
+    std::vector<zome::BallId> cellBalls;   ///< cell → the ball it attaches to
+    std::vector<uint32_t> faceCells;       ///< per face: the cell containing its centroid
+    std::vector<uint32_t> facePieces;      ///< per face: its piece
     std::vector<Piece> pieces;
-    std::vector<uint8_t> salientFaces;      ///< per face (after spheres and indices)
-    size_t salientRegions = 0;              ///< edge-connected salient regions
-    size_t salientRegionsSplit = 0;         ///< regions a final seam still crosses (0 normally)
+    std::vector<uint8_t> salientFaces;  ///< per face (after spheres and indices)
+    size_t salientRegions = 0;          ///< edge-connected salient regions
+    size_t salientRegionsSplit = 0;     ///< regions a final seam still crosses (0 normally)
 
     std::vector<ScheduleStep> schedule;
-    double smoothnessWeight = 0.0;          ///< w_smoothness of the last schedule step
-    double energyNearest = 0.0;             ///< the last step's ScheduleStep::energyNearest
-    double energyGraphCut = 0.0;            ///< the last step's ScheduleStep::energyGraphCut
-    std::vector<double> sweepEnergies;      ///< of the last step's graph cut
-    size_t nearestPartitions = 0;           ///< connected regions of the nearest-ball labelling
-    size_t graphCutPartitions = 0;          ///< connected regions of graphCutLabels (before splits)
-    bool isScheduleBottomedOut = false;     ///< the schedule ended without every partition fitting
-    size_t splits = 0;                      ///< partitions/pieces split to fit the printer
-    size_t merges = 0;                      ///< small pieces merged into a neighbour
-    size_t regionMerges = 0;                ///< regions merged after the schedule (mergeSmallRegions)
-    size_t svmSamples = 0;                  ///< training samples used
-    double svmAgreement = 0.0;              ///< fraction of faces whose cell matches its region
-    size_t graphNodes = 0;                  ///< nodes of the first graph cut (faces or clusters;
-                                            ///< a salient region is one node)
-    size_t refineNodes = 0;                 ///< nodes of the refinement level (faces or small clusters)
-    size_t candidatePairs = 0;              ///< Σ candidates over those nodes: "triangles × labels"
+    double smoothnessWeight = 0.0;       ///< w_smoothness of the last schedule step
+    double energyNearest = 0.0;          ///< the last step's ScheduleStep::energyNearest
+    double energyGraphCut = 0.0;         ///< the last step's ScheduleStep::energyGraphCut
+    std::vector<double> sweepEnergies;   ///< of the last step's graph cut
+    size_t nearestPartitions = 0;        ///< connected regions of the nearest-ball labelling
+    size_t graphCutPartitions = 0;       ///< connected regions of graphCutLabels (before splits)
+    bool isScheduleBottomedOut = false;  ///< the schedule ended without every partition fitting
+    size_t splits = 0;                   ///< partitions/pieces split to fit the printer
+    size_t merges = 0;                   ///< small pieces merged into a neighbour
+    size_t regionMerges = 0;             ///< regions merged after the schedule (mergeSmallRegions)
+    size_t svmSamples = 0;               ///< training samples used
+    double svmAgreement = 0.0;           ///< fraction of faces whose cell matches its region
+    size_t graphNodes = 0;               ///< nodes of the first graph cut (faces or clusters;
+                                         ///< a salient region is one node)
+    size_t refineNodes = 0;              ///< nodes of the refinement level (faces or small clusters)
+    size_t candidatePairs = 0;           ///< Σ candidates over those nodes: "triangles × labels"
     double secondsGraphCut = 0.0;
     double secondsSvm = 0.0;
     double secondsTotal = 0.0;

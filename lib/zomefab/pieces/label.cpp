@@ -33,8 +33,8 @@ double digitGapMm(const LabelOptions& o) { return std::max(0.3 * o.heightMm, 1.5
 void checkLabelOptions(const LabelOptions& o) {
     auto require = [](double v, double lo, double hi, const char* what) {
         if (!(v >= lo && v <= hi))
-            throw Error(ErrorCode::Usage, std::string(what) + " must be in [" + formatNumber(lo) + ", " + formatNumber(hi) +
-                                              "] mm, got " + formatNumber(v));
+            throw Error(ErrorCode::Usage, std::string(what) + " must be in [" + formatNumber(lo) + ", " +
+                                              formatNumber(hi) + "] mm, got " + formatNumber(v));
     };
     require(o.heightMm, 3.0, 50.0, "the label height");
     require(o.strokeMm, 0.5, o.heightMm / 3.0, "the label stroke");
@@ -58,7 +58,8 @@ std::vector<Stroke> labelStrokes(const std::string& text, const LabelOptions& o)
     const double shiftY = s;
     double left = -0.5 * size[0];
     for (char ch : text) {
-        if (ch < '0' || ch > '9') throw Error(ErrorCode::Internal, std::string("label character '") + ch + "' is not a digit");
+        if (ch < '0' || ch > '9')
+            throw Error(ErrorCode::Internal, std::string("label character '") + ch + "' is not a digit");
         const uint8_t bits = kSegments[ch - '0'];
         const double cx = left + 0.5 * w;
         const double xl = cx - 0.5 * w + 0.5 * s, xr = cx + 0.5 * w - 0.5 * s;
@@ -78,15 +79,16 @@ std::vector<Stroke> labelStrokes(const std::string& text, const LabelOptions& o)
     return strokes;
 }
 
-double labelSignedDistanceMm(const PieceLabel& label, const std::vector<Stroke>& strokes, const LabelOptions& o,
-                             const Vec3d& p) {
+double labelSignedDistanceMm(const PieceLabel& label, const std::vector<Stroke>& strokes,
+                             const LabelOptions& o, const Vec3d& p) {
     const Vec3d right = cross(label.upGrid, label.normalGrid);
     const Vec3d d = sub(p, label.centerGridMm);
     const double x = dot(d, right), y = dot(d, label.upGrid), z = dot(d, label.normalGrid);
     const double zMid = 0.5 * (kAboveSurfaceMm - o.depthMm), zHalf = 0.5 * (kAboveSurfaceMm + o.depthMm);
     double best = 1e30;
     for (const Stroke& s : strokes)
-        best = std::min(best, boxDistance({x - s.centerX, y - s.centerY, z - zMid}, {s.halfWidth, s.halfHeight, zHalf}));
+        best = std::min(
+            best, boxDistance({x - s.centerX, y - s.centerY, z - zMid}, {s.halfWidth, s.halfHeight, zHalf}));
     return best;
 }
 
@@ -96,13 +98,15 @@ Box3d labelBoundsMm(const PieceLabel& label, const LabelOptions& o) {
     for (double x : {-0.5 * label.widthMm, 0.5 * label.widthMm})
         for (double y : {-0.5 * label.heightMm, 0.5 * label.heightMm})
             for (double z : {-o.depthMm, kAboveSurfaceMm})
-                box.expand(madd(madd(madd(label.centerGridMm, x, right), y, label.upGrid), z, label.normalGrid));
+                box.expand(
+                    madd(madd(madd(label.centerGridMm, x, right), y, label.upGrid), z, label.normalGrid));
     return box;
 }
 
 std::vector<std::vector<SurfaceSpot>> innerSurfaceSpots(const zome::Structure& frame,
-                                                        const Transform4d& frameToGridMm, const ShellProbe& probe,
-                                                        size_t pieceCount, double maxDistanceMm) {
+                                                        const Transform4d& frameToGridMm,
+                                                        const ShellProbe& probe, size_t pieceCount,
+                                                        double maxDistanceMm) {
     std::vector<std::vector<SurfaceSpot>> spots(pieceCount);
     const double step = 0.5 * probe.voxelMm;
     const double start = frame.scale().ballRadiusMm();
@@ -134,9 +138,10 @@ std::vector<std::vector<SurfaceSpot>> innerSurfaceSpots(const zome::Structure& f
     return spots;
 }
 
-std::optional<PieceLabel> placeLabel(const std::string& text, uint32_t piece, const std::vector<SurfaceSpot>& spots,
-                                     const std::vector<Tenon>& tenons, const TenonOptions& tenonOptions,
-                                     const ShellProbe& probe, const LabelOptions& o, std::string* note) {
+std::optional<PieceLabel> placeLabel(const std::string& text, uint32_t piece,
+                                     const std::vector<SurfaceSpot>& spots, const std::vector<Tenon>& tenons,
+                                     const TenonOptions& tenonOptions, const ShellProbe& probe,
+                                     const LabelOptions& o, std::string* note) {
     const Vec3d size = labelSizeMm(text, o);
     const double halfW = 0.5 * size[0], halfH = 0.5 * size[1];
     const double sample = std::max(0.5 * o.strokeMm, 0.5 * probe.voxelMm);
@@ -160,7 +165,8 @@ std::optional<PieceLabel> placeLabel(const std::string& text, uint32_t piece, co
         bool isOk = true;
         for (double x : {-halfW - o.marginMm, 0.0, halfW + o.marginMm})
             for (double y : {-halfH - o.marginMm, 0.0, halfH + o.marginMm})
-                if (std::abs(probe.signedDistanceMm(at(x, y))) > 2 * o.flatnessMm + probe.voxelMm) isOk = false;
+                if (std::abs(probe.signedDistanceMm(at(x, y))) > 2 * o.flatnessMm + probe.voxelMm)
+                    isOk = false;
         if (!isOk) continue;
         ++tried;
         double deviation = 0;
@@ -173,11 +179,14 @@ std::optional<PieceLabel> placeLabel(const std::string& text, uint32_t piece, co
                 // Under the label the surface stays within flatnessMm of the plane; in the margin it is
                 // still this piece's inner surface (a cut face or the wall's edge would break either).
                 if (isUnderLabel) deviation = std::max(deviation, std::abs(phi));
-                if (std::abs(phi) > (isUnderLabel ? o.flatnessMm : 2 * o.flatnessMm + 0.5 * probe.voxelMm)) isOk = false;
+                if (std::abs(phi) > (isUnderLabel ? o.flatnessMm : 2 * o.flatnessMm + 0.5 * probe.voxelMm))
+                    isOk = false;
                 const Vec3d inWall = madd(q, -wallProbe, n);
-                if (probe.signedDistanceMm(inWall) >= 0 || probe.pieceAt(inWall) != int64_t(piece)) isOk = false;
+                if (probe.signedDistanceMm(inWall) >= 0 || probe.pieceAt(inWall) != int64_t(piece))
+                    isOk = false;
                 for (const Tenon& t : tenons) {
-                    const double d2 = zome::pointSegmentDistanceSq(q, t.pointAt(t.pegTipMm), t.pointAt(t.endMm));
+                    const double d2 =
+                        zome::pointSegmentDistanceSq(q, t.pointAt(t.pegTipMm), t.pointAt(t.endMm));
                     if (d2 < keepOut * keepOut) isOk = false;
                 }
             }

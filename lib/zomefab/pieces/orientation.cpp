@@ -38,7 +38,8 @@ std::vector<std::array<double, 2>> convexHull(std::vector<std::array<double, 2>>
     p.erase(std::unique(p.begin(), p.end()), p.end());
     if (p.size() < 3) return p;
     std::vector<std::array<double, 2>> h(2 * p.size());
-    auto turn = [](const std::array<double, 2>& o, const std::array<double, 2>& a, const std::array<double, 2>& b) {
+    auto turn = [](const std::array<double, 2>& o, const std::array<double, 2>& a,
+                   const std::array<double, 2>& b) {
         return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
     };
     size_t k = 0;
@@ -165,7 +166,8 @@ double sectionArea(const MeshD& m, const Vec3d& down, double h) {
         double height[4];
         const int n = clipBelow(v, z, top, poly, height);
         Vec3d area{0, 0, 0};
-        for (int k = 1; k + 1 < n; ++k) area = add(area, cross(sub(poly[k], poly[0]), sub(poly[k + 1], poly[0])));
+        for (int k = 1; k + 1 < n; ++k)
+            area = add(area, cross(sub(poly[k], poly[0]), sub(poly[k + 1], poly[0])));
         flux += 0.5 * dot(area, up);
     }
     return std::max(0.0, -flux);
@@ -193,7 +195,8 @@ double contactMm2(const MeshD& m, const Vec3d& down, double h) {
         double height[4];
         const int n = clipBelow(v, z, top, corner, height);
         for (int k = 1; k + 1 < n; ++k) {
-            const double projected = -0.5 * dot(cross(sub(corner[k], corner[0]), sub(corner[k + 1], corner[0])), up);
+            const double projected =
+                -0.5 * dot(cross(sub(corner[k], corner[0]), sub(corner[k + 1], corner[0])), up);
             const double zMean = (height[0] + height[k] + height[k + 1]) / 3.0 - lowest;
             sum += projected * std::max(0.0, 1.0 - zMean / h);
         }
@@ -218,7 +221,8 @@ std::vector<Vec3d> facetDirections(const MeshD& m) {
     for (const auto& [negArea, i] : bySize) {
         if (out.size() == kFacetDirections || negArea == 0.0) break;
         const Vec3d n = normalized(m.vectorArea[i]);
-        if (std::none_of(out.begin(), out.end(), [&](const Vec3d& d) { return dot(d, n) > kSameDirectionCos; }))
+        if (std::none_of(out.begin(), out.end(),
+                         [&](const Vec3d& d) { return dot(d, n) > kSameDirectionCos; }))
             out.push_back(n);
     }
     return out;
@@ -253,7 +257,8 @@ Vec3d tiltTowardsLargerBase(const MeshD& m, Vec3d down, double& contact, Fits&& 
                 if (a > contact * (1.0 + 1e-9) + 1e-9) larger.push_back({a, d});
             }
             // Largest first; ties keep the order of the sides.
-            std::stable_sort(larger.begin(), larger.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+            std::stable_sort(larger.begin(), larger.end(),
+                             [](const auto& x, const auto& y) { return x.first > y.first; });
             bool isMoved = false;
             for (const auto& [a, d] : larger)
                 if (fits(d)) {
@@ -272,7 +277,8 @@ std::vector<CutFace> measureCutFaces(const TriMesh& mesh, const std::vector<CutF
     std::vector<CutFace> faces = planes;
     for (CutFace& f : faces) f.areaMm2 = 0;
     for (const Triangle& t : mesh.triangles) {
-        const Vec3d a = toD(mesh.positions[t[0]]), b = toD(mesh.positions[t[1]]), c = toD(mesh.positions[t[2]]);
+        const Vec3d a = toD(mesh.positions[t[0]]), b = toD(mesh.positions[t[1]]),
+                    c = toD(mesh.positions[t[2]]);
         const Vec3d n2 = cross(sub(b, a), sub(c, a));
         const double area2 = norm(n2);
         if (area2 <= 0) continue;
@@ -288,7 +294,8 @@ std::vector<CutFace> measureCutFaces(const TriMesh& mesh, const std::vector<CutF
     }
     faces.erase(std::remove_if(faces.begin(), faces.end(), [](const CutFace& f) { return f.areaMm2 <= 0; }),
                 faces.end());
-    std::stable_sort(faces.begin(), faces.end(), [](const CutFace& x, const CutFace& y) { return x.areaMm2 > y.areaMm2; });
+    std::stable_sort(faces.begin(), faces.end(),
+                     [](const CutFace& x, const CutFace& y) { return x.areaMm2 > y.areaMm2; });
     return faces;
 }
 
@@ -296,8 +303,8 @@ double baseAreaMm2(const TriMesh& mesh, const Vec3d& down, double heightMm) {
     return sectionArea(MeshD(mesh), down, heightMm);
 }
 
-PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFace>& cutFaces, const Vec3d& printer,
-                                  double flatToleranceMm) {
+PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFace>& cutFaces,
+                                  const Vec3d& printer, double flatToleranceMm) {
     PrintOrientation out;
     if (meshMm.positions.empty()) return out;
     const MeshD mesh(meshMm);
@@ -360,8 +367,9 @@ PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFa
         for (const auto& [negContact, i] : byContact) {
             if (starts.size() == kRefineStarts) break;
             if (-negContact <= bestContact) break;  // tilting only enlarges: no later start can win
-            const bool isNear = std::any_of(starts.begin(), starts.end(),
-                                            [&](const Vec3d& s) { return dot(s, directions[i]) > kSameDirectionCos; });
+            const bool isNear = std::any_of(starts.begin(), starts.end(), [&](const Vec3d& s) {
+                return dot(s, directions[i]) > kSameDirectionCos;
+            });
             if (isNear || !fits(directions[i])) continue;
             starts.push_back(directions[i]);
             double contact = -negContact;
@@ -396,21 +404,24 @@ PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFa
     const Vec3d& r2 = chosen.rows[2];
     Box3d box;
     for (const Vec3d& p : points) box.expand({dot(r0, p), dot(r1, p), dot(r2, p)});
-    const Vec3d t{0.5 * printer[0] - 0.5 * (box.min[0] + box.max[0]), 0.5 * printer[1] - 0.5 * (box.min[1] + box.max[1]),
-                  -box.min[2]};
-    out.transformMm.m = {r0[0], r0[1], r0[2], t[0], r1[0], r1[1], r1[2], t[1], r2[0], r2[1], r2[2], t[2], 0, 0, 0, 1};
+    const Vec3d t{0.5 * printer[0] - 0.5 * (box.min[0] + box.max[0]),
+                  0.5 * printer[1] - 0.5 * (box.min[1] + box.max[1]), -box.min[2]};
+    out.transformMm.m = {r0[0], r0[1], r0[2], t[0], r1[0], r1[1], r1[2], t[1],
+                         r2[0], r2[1], r2[2], t[2], 0,     0,     0,     1};
     out.extentsMm = box.size();
-    out.ratio = std::max({out.extentsMm[0] / printer[0], out.extentsMm[1] / printer[1], out.extentsMm[2] / printer[2]});
+    out.ratio = std::max(
+        {out.extentsMm[0] / printer[0], out.extentsMm[1] / printer[1], out.extentsMm[2] / printer[2]});
     out.fits = out.ratio <= 1.0;
     out.baseAreaMm2 = sectionArea(mesh, out.downNormal, kBaseHeightMm);
     if (!out.isCutFaceDown) {
         std::ostringstream note;
         note.precision(4);
-        note << "no cut face on the bed (of " << cutFaces.size() << ": " << behind << " with the piece beyond them";
+        note << "no cut face on the bed (of " << cutFaces.size() << ": " << behind
+             << " with the piece beyond them";
         if (behind > 0) note << " by " << leastBeyondMm << " mm or more";
         if (!cutFaces.empty())
-            note << "; the largest, " << cutFaces[0].areaMm2 << " mm², has it " << std::max(0.0, beyondMm(cutFaces[0]))
-                 << " mm beyond";
+            note << "; the largest, " << cutFaces[0].areaMm2 << " mm², has it "
+                 << std::max(0.0, beyondMm(cutFaces[0])) << " mm beyond";
         note << ", " << small << " under " << kMinCutFaceAreaMm2 << " mm², " << tooLarge
              << " too large for the printer); it rests on " << out.baseAreaMm2 << " mm²";
         out.note = note.str();

@@ -48,12 +48,12 @@ void checkPiecesOptions(const PiecesOptions& options);
 /// One printable piece.
 struct Piece {
     uint32_t id = 0;
-    std::vector<uint32_t> cells;      ///< cells it is cut from (sorted)
-    std::vector<uint32_t> requests;   ///< the partition's pieces it comes from (sorted)
+    std::vector<uint32_t> cells;     ///< cells it is cut from (sorted)
+    std::vector<uint32_t> requests;  ///< the partition's pieces it comes from (sorted)
     /// Pieces sharing a cut face, with the face's area (mm², first order in the voxel).
     std::vector<std::pair<uint32_t, double>> neighbors;
-    uint32_t sliversMerged = 0;       ///< small components merged into this piece
-    double shellVolumeMm3 = 0.0;      ///< its part of the shell, counted in voxels
+    uint32_t sliversMerged = 0;   ///< small components merged into this piece
+    double shellVolumeMm3 = 0.0;  ///< its part of the shell, counted in voxels
 
     std::vector<Tenon> tenons;
     /// When fewer than TenonOptions::minPerPiece tenons were found: why each candidate ray failed
@@ -66,16 +66,16 @@ struct Piece {
     /// The printable mesh, in printer coordinates (on the bed z = 0, centred in x and y): closed,
     /// 2-manifold, outward-oriented.
     TriMesh mesh;
-    Transform4d gridToPrintMm;        ///< shell-grid mm → printer mm (a rotation and a translation)
-    bool isCutFaceDown = false;       ///< a planar cut face lies on the bed
-    Vec3d downNormalGridMm{0, 0, -1}; ///< the outward normal (grid mm) that points down when printed
+    Transform4d gridToPrintMm;         ///< shell-grid mm → printer mm (a rotation and a translation)
+    bool isCutFaceDown = false;        ///< a planar cut face lies on the bed
+    Vec3d downNormalGridMm{0, 0, -1};  ///< the outward normal (grid mm) that points down when printed
     /// Area of the piece's cross-section kBaseHeightMm (0.2 mm) above the bed: what the first
     /// layer prints. A cut face down gives its area; a piece with none rests on the largest base
     /// that fits (docs/pieces.md, "Orientation").
     double baseAreaMm2 = 0.0;
-    Vec3d extentsMm{0, 0, 0};         ///< size of the printed piece along the printer's x, y, z
-    double volumeMm3 = 0.0;           ///< of the mesh
-    Box3d gridBoundsMm;               ///< of the mesh in the shell grid's mm
+    Vec3d extentsMm{0, 0, 0};  ///< size of the printed piece along the printer's x, y, z
+    double volumeMm3 = 0.0;    ///< of the mesh
+    Box3d gridBoundsMm;        ///< of the mesh in the shell grid's mm
 };
 
 /// The result of makePieces.
@@ -83,13 +83,13 @@ struct Pieces {
     std::vector<Piece> pieces;
     Vec3d printerMm = Fabrication{}.printerMm;  ///< the Fabrication's printer they were oriented for
     double voxelMm = 0.0;
-    double shellVolumeMm3 = 0.0;        ///< the shell, counted in voxels
+    double shellVolumeMm3 = 0.0;  ///< the shell, counted in voxels
     /// Shell volume in cells no request names (no outer surface there): merged into neighbours.
     double outsideCellsVolumeMm3 = 0.0;
     size_t sliversMerged = 0;
-    size_t isolatedSlivers = 0;         ///< small pieces with no neighbour to merge into (kept)
+    size_t isolatedSlivers = 0;  ///< small pieces with no neighbour to merge into (kept)
     Transform4d frameToGridMm;
-    Transform4d gridTransformMm;        ///< the shell's LevelSetInfo::transformMm (input mesh → grid mm)
+    Transform4d gridTransformMm;  ///< the shell's LevelSetInfo::transformMm (input mesh → grid mm)
     PiecesOptions options;
     double seconds = 0.0;
 };

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "zomefab/core/json_values.h"
 #include "zomefab/core/error.h"
+#include "zomefab/core/json_values.h"
 #include "zomefab/core/vec.h"
 #include "zomefab/core/version.h"
 #include "zomefab/io/file_io.h"
@@ -17,10 +17,7 @@ namespace zomefab::pieces {
 
 using nlohmann::json;
 
-namespace {
-
-
-}  // namespace
+namespace {}  // namespace
 
 std::string pieceName(const Pieces& pieces, size_t index) {
     size_t width = 2;
@@ -74,7 +71,8 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
         if (p.tenons.size() < size_t(o.tenons.minPerPiece)) ++fewTenons;
         if (p.label) ++labelled;
         json neighbors = json::array();
-        for (const auto& [id, area] : p.neighbors) neighbors.push_back({{"piece", id}, {"contact_mm2", area}});
+        for (const auto& [id, area] : p.neighbors)
+            neighbors.push_back({{"piece", id}, {"contact_mm2", area}});
         json tenons = json::array();
         for (const Tenon& t : p.tenons) {
             tenons.push_back({{"ball", t.ball},
@@ -92,7 +90,8 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
         }
         json shortfall = nullptr;
         if (p.tenons.size() < size_t(o.tenons.minPerPiece)) {
-            shortfall = {{"found", p.tenons.size()}, {"wanted", o.tenons.minPerPiece}, {"reasons", json::object()}};
+            shortfall = {
+                {"found", p.tenons.size()}, {"wanted", o.tenons.minPerPiece}, {"reasons", json::object()}};
             for (const auto& [why, count] : p.tenonShortfall) shortfall["reasons"][why] = count;
         }
         json label = nullptr;
@@ -146,7 +145,8 @@ void writePiecesThreeMf(const Pieces& all, const std::string& path) {
     for (size_t i = 0; i < all.pieces.size(); ++i) {
         const double dx = double(i % columns) * (all.printerMm[0] + 10.0);
         const double dy = double(i / columns) * (all.printerMm[1] + 10.0);
-        objects.push_back({pieceName(all, i), &all.pieces[i].mesh, Transform4d::scaleTranslate(1.0, {dx, dy, 0.0})});
+        objects.push_back(
+            {pieceName(all, i), &all.pieces[i].mesh, Transform4d::scaleTranslate(1.0, {dx, dy, 0.0})});
     }
     writeThreeMf(objects, generatorString(), path);
 }

@@ -62,7 +62,8 @@ void readOptions(const json& o, PiecesOptions& options) {
     to.maxLengthMm = numberFromJson(requireMember(t, "max_length_mm", "tenons"), "tenons.max_length_mm");
     to.maxTiltDeg = numberFromJson(requireMember(t, "max_tilt_deg", "tenons"), "tenons.max_tilt_deg");
     to.embedMm = numberFromJson(requireMember(t, "embed_mm", "tenons"), "tenons.embed_mm");
-    to.frameClearanceMm = numberFromJson(requireMember(t, "frame_clearance_mm", "tenons"), "tenons.frame_clearance_mm");
+    to.frameClearanceMm =
+        numberFromJson(requireMember(t, "frame_clearance_mm", "tenons"), "tenons.frame_clearance_mm");
     to.latticeHolesOnly = t.value("holes", "blue") == "lattice";
 }
 
@@ -78,7 +79,8 @@ Tenon tenonFromJson(const json& j, uint32_t piece, const std::string& what) {
     t.ballCenterGridMm = vec3FromJson(requireMember(j, "ball_center_mm", what), what + ".ball_center_mm");
     // The distances along the axis, from the points written.
     auto along = [&](const char* key) {
-        return dot(sub(vec3FromJson(requireMember(j, key, what), what + "." + key), t.ballCenterGridMm), t.axisGrid);
+        return dot(sub(vec3FromJson(requireMember(j, key, what), what + "." + key), t.ballCenterGridMm),
+                   t.axisGrid);
     };
     t.pegTipMm = along("peg_tip_mm");
     t.shoulderMm = along("shoulder_mm");
@@ -89,13 +91,16 @@ Tenon tenonFromJson(const json& j, uint32_t piece, const std::string& what) {
 }
 
 void readOrientation(const json& o, Piece& piece, const std::string& what) {
-    auto vec = [&](const char* key) { return [&, key](const json& v) { return vec3FromJson(v, what + "." + key); }; };
-    piece.gridToPrintMm = optionalField(o, "transform_mm", Transform4d::identity(),
-                                        [&](const json& v) { return transformFromJson(v, what + ".transform_mm"); });
+    auto vec = [&](const char* key) {
+        return [&, key](const json& v) { return vec3FromJson(v, what + "." + key); };
+    };
+    piece.gridToPrintMm = optionalField(o, "transform_mm", Transform4d::identity(), [&](const json& v) {
+        return transformFromJson(v, what + ".transform_mm");
+    });
     piece.isCutFaceDown = o.value("cut_face_down", false);
     piece.downNormalGridMm = optionalField(o, "down_normal", Vec3d{0, 0, -1}, vec("down_normal"));
-    piece.baseAreaMm2 = optionalField(o, "base_area_mm2", 0.0,
-                                      [&](const json& v) { return numberFromJson(v, what + ".base_area_mm2"); });
+    piece.baseAreaMm2 = optionalField(
+        o, "base_area_mm2", 0.0, [&](const json& v) { return numberFromJson(v, what + ".base_area_mm2"); });
     piece.extentsMm = optionalField(o, "extents_mm", Vec3d{0, 0, 0}, vec("extents_mm"));
 }
 
@@ -103,25 +108,34 @@ Piece pieceFromJson(const json& j, size_t index, const std::string& directory) {
     const std::string what = "pieces[" + std::to_string(index) + "]";
     if (!j.is_object()) fail(what + " must be an object");
     Piece piece;
-    auto number = [&](const char* key) { return [&, key](const json& v) { return numberFromJson(v, what + "." + key); }; };
-    auto indices = [&](const char* key) { return [&, key](const json& v) { return indicesFromJson(v, what + "." + key); }; };
-    piece.id = optionalField(j, "piece", uint32_t(index), [&](const json& v) { return indexFromJson(v, what + ".piece"); });
+    auto number = [&](const char* key) {
+        return [&, key](const json& v) { return numberFromJson(v, what + "." + key); };
+    };
+    auto indices = [&](const char* key) {
+        return [&, key](const json& v) { return indicesFromJson(v, what + "." + key); };
+    };
+    piece.id = optionalField(j, "piece", uint32_t(index),
+                             [&](const json& v) { return indexFromJson(v, what + ".piece"); });
     piece.volumeMm3 = optionalField(j, "volume_mm3", 0.0, number("volume_mm3"));
     piece.shellVolumeMm3 = optionalField(j, "shell_volume_mm3", 0.0, number("shell_volume_mm3"));
-    piece.gridBoundsMm =
-        optionalField(j, "grid_bbox_mm", Box3d{}, [&](const json& v) { return boxFromJson(v, what + ".grid_bbox_mm"); });
+    piece.gridBoundsMm = optionalField(j, "grid_bbox_mm", Box3d{},
+                                       [&](const json& v) { return boxFromJson(v, what + ".grid_bbox_mm"); });
     readOrientation(j.value("orientation", json::object()), piece, what + ".orientation");
     piece.cells = optionalField(j, "cells", std::vector<uint32_t>{}, indices("cells"));
-    piece.requests = optionalField(j, "partition_pieces", std::vector<uint32_t>{}, indices("partition_pieces"));
+    piece.requests =
+        optionalField(j, "partition_pieces", std::vector<uint32_t>{}, indices("partition_pieces"));
     for (const json& n : j.value("neighbors", json::array()))
-        piece.neighbors.push_back({indexFromJson(requireMember(n, "piece", what), what + ".neighbors"),
-                                   numberFromJson(requireMember(n, "contact_mm2", what), what + ".neighbors")});
-    piece.sliversMerged = optionalField(j, "slivers_merged", uint32_t(0),
-                                        [&](const json& v) { return indexFromJson(v, what + ".slivers_merged"); });
+        piece.neighbors.push_back(
+            {indexFromJson(requireMember(n, "piece", what), what + ".neighbors"),
+             numberFromJson(requireMember(n, "contact_mm2", what), what + ".neighbors")});
+    piece.sliversMerged = optionalField(j, "slivers_merged", uint32_t(0), [&](const json& v) {
+        return indexFromJson(v, what + ".slivers_merged");
+    });
     const json tenons = j.value("tenons", json::array());
     if (!tenons.is_array()) fail(what + ".tenons must be a list");
     for (size_t t = 0; t < tenons.size(); ++t)
-        piece.tenons.push_back(tenonFromJson(tenons[t], piece.id, what + ".tenons[" + std::to_string(t) + "]"));
+        piece.tenons.push_back(
+            tenonFromJson(tenons[t], piece.id, what + ".tenons[" + std::to_string(t) + "]"));
     const json& shortfall = j.value("tenon_shortfall", json());
     if (shortfall.is_object() && shortfall.contains("reasons") && shortfall["reasons"].is_object())
         for (const auto& [why, count] : shortfall["reasons"].items())
@@ -139,7 +153,8 @@ Piece pieceFromJson(const json& j, size_t index, const std::string& directory) {
         l.heightMm = numberFromJson(size[1], what + ".label.size_mm");
         piece.label = l;
     }
-    if (j.contains("label_note") && j["label_note"].is_string()) piece.labelNote = j["label_note"].get<std::string>();
+    if (j.contains("label_note") && j["label_note"].is_string())
+        piece.labelNote = j["label_note"].get<std::string>();
     const json& file = requireMember(j, "file", what);
     if (!file.is_string() || file.get<std::string>().find('/') != std::string::npos)
         fail(what + ".file must be a file name next to pieces.json");
@@ -152,20 +167,28 @@ Piece pieceFromJson(const json& j, size_t index, const std::string& directory) {
 Pieces piecesFromJson(const json& j, const std::string& directory) {
     if (!j.is_object() || j.value("format", "") != kPiecesFormatName)
         fail(std::string("not a pieces file (format is not \"") + kPiecesFormatName + "\")");
-    if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<int>() != kPiecesFormatVersion)
+    if (!j.contains("version") || !j["version"].is_number_integer() ||
+        j["version"].get<int>() != kPiecesFormatVersion)
         fail("unsupported pieces file version (expected " + std::to_string(kPiecesFormatVersion) + ")");
     Pieces out;
-    out.printerMm = optionalField(j, "printer_mm", out.printerMm, [](const json& v) { return vec3FromJson(v, "printer_mm"); });
-    out.voxelMm = optionalField(j, "voxel_mm", 0.0, [](const json& v) { return numberFromJson(v, "voxel_mm"); });
-    auto transform = [](const char* key) { return [key](const json& v) { return transformFromJson(v, key); }; };
-    out.gridTransformMm = optionalField(j, "grid_transform_mm", Transform4d::identity(), transform("grid_transform_mm"));
-    out.frameToGridMm = optionalField(j, "frame_to_grid_mm", Transform4d::identity(), transform("frame_to_grid_mm"));
+    out.printerMm = optionalField(j, "printer_mm", out.printerMm,
+                                  [](const json& v) { return vec3FromJson(v, "printer_mm"); });
+    out.voxelMm =
+        optionalField(j, "voxel_mm", 0.0, [](const json& v) { return numberFromJson(v, "voxel_mm"); });
+    auto transform = [](const char* key) {
+        return [key](const json& v) { return transformFromJson(v, key); };
+    };
+    out.gridTransformMm =
+        optionalField(j, "grid_transform_mm", Transform4d::identity(), transform("grid_transform_mm"));
+    out.frameToGridMm =
+        optionalField(j, "frame_to_grid_mm", Transform4d::identity(), transform("frame_to_grid_mm"));
     if (j.contains("options")) readOptions(j["options"], out.options);
     const json& pieces = requireMember(j, "pieces", "pieces file");
     if (!pieces.is_array()) fail("pieces must be a list");
     for (size_t i = 0; i < pieces.size(); ++i) {
         out.pieces.push_back(pieceFromJson(pieces[i], i, directory));
-        if (out.pieces.back().id != i) fail("pieces[" + std::to_string(i) + "].piece must be " + std::to_string(i));
+        if (out.pieces.back().id != i)
+            fail("pieces[" + std::to_string(i) + "].piece must be " + std::to_string(i));
     }
     const json& summary = j.value("summary", json::object());
     out.shellVolumeMm3 = summary.value("shell_volume_mm3", 0.0);
@@ -181,7 +204,8 @@ Pieces readPieces(const std::string& path) {
     const json j = json::parse(readInputBytes(file), nullptr, false);
     if (j.is_discarded()) throw Error(ErrorCode::InvalidInput, "invalid JSON", file);
     try {
-        return piecesFromJson(j, fs::path(file).parent_path().string().empty() ? "." : fs::path(file).parent_path().string());
+        return piecesFromJson(
+            j, fs::path(file).parent_path().string().empty() ? "." : fs::path(file).parent_path().string());
     } catch (const Error& e) {
         throw e.withFile(file);
     } catch (const json::exception& e) {

@@ -48,16 +48,18 @@ constexpr double kPegOverlapMm = 0.5;
 
 void requireRange(double value, double lo, double hi, const char* name, const char* unit) {
     if (!(value >= lo && value <= hi))
-        throw Error(ErrorCode::Usage, std::string(name) + " must be in [" + formatNumber(lo) + ", " + formatNumber(hi) + "] " + unit +
-                                          ", got " + formatNumber(value));
+        throw Error(ErrorCode::Usage, std::string(name) + " must be in [" + formatNumber(lo) + ", " +
+                                          formatNumber(hi) + "] " + unit + ", got " + formatNumber(value));
 }
 
 /// Refines the first crossing φ < 0 on the ray between t0 (outside) and t1 (inside).
 double bisect(const ShellProbe& probe, const Vec3d& origin, const Vec3d& dir, double t0, double t1) {
     for (int i = 0; i < 24; ++i) {
         const double tm = 0.5 * (t0 + t1);
-        if (probe.signedDistanceMm(madd(origin, tm, dir)) < 0) t1 = tm;
-        else t0 = tm;
+        if (probe.signedDistanceMm(madd(origin, tm, dir)) < 0)
+            t1 = tm;
+        else
+            t0 = tm;
     }
     return 0.5 * (t0 + t1);
 }
@@ -66,18 +68,22 @@ double bisect(const ShellProbe& probe, const Vec3d& origin, const Vec3d& dir, do
 
 void checkTenonOptions(const TenonOptions& o) {
     if (o.minPerPiece < 0 || o.minPerPiece > 62)
-        throw Error(ErrorCode::Usage, "the tenons wanted per piece must be in [0, 62], got " + std::to_string(o.minPerPiece));
+        throw Error(ErrorCode::Usage,
+                    "the tenons wanted per piece must be in [0, 62], got " + std::to_string(o.minPerPiece));
     if (o.maxPerPiece < 0 || o.maxPerPiece > 62)
-        throw Error(ErrorCode::Usage, "the most tenons per piece must be in [0, 62], got " + std::to_string(o.maxPerPiece));
+        throw Error(ErrorCode::Usage,
+                    "the most tenons per piece must be in [0, 62], got " + std::to_string(o.maxPerPiece));
     if (o.maxPerPiece > 0 && o.maxPerPiece < o.minPerPiece)
         throw Error(ErrorCode::Usage, "the most tenons per piece (" + std::to_string(o.maxPerPiece) +
-                                          ") is below the number wanted (" + std::to_string(o.minPerPiece) + ")");
+                                          ") is below the number wanted (" + std::to_string(o.minPerPiece) +
+                                          ")");
     requireRange(o.clearanceMm, 0.0, 0.5, "the tenon clearance", "mm");
     requireRange(o.holeLongMm, 1.0, 20.0, "the hole's long side", "mm");
     requireRange(o.holeShortMm, 1.0, o.holeLongMm, "the hole's short side", "mm");
     if (pegShortMm(o) < 1.0)
-        throw Error(ErrorCode::Usage, "the peg (hole less twice the clearance) must be at least 1 mm thick, got " +
-                                          formatNumber(pegShortMm(o)) + " mm");
+        throw Error(ErrorCode::Usage,
+                    "the peg (hole less twice the clearance) must be at least 1 mm thick, got " +
+                        formatNumber(pegShortMm(o)) + " mm");
     requireRange(o.pegDepthMm, 1.0, 8.0, "the peg depth", "mm");
     requireRange(o.bodyWidthMm, pegLongMm(o), 20.0, "the tenon width", "mm");
     requireRange(o.maxLengthMm, 1.0, 200.0, "the longest tenon", "mm");
@@ -93,7 +99,8 @@ double tenonSignedDistanceMm(const Tenon& t, const TenonOptions& o, const Vec3d&
     const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
     const double a = dot(d, t.axisGrid), l = dot(d, t.longSideGrid), s = dot(d, shortSide);
     const double bodyMid = 0.5 * (t.shoulderMm + t.endMm), bodyHalf = 0.5 * (t.endMm - t.shoulderMm);
-    const double body = boxDistance({a - bodyMid, l, s}, {bodyHalf, 0.5 * o.bodyWidthMm, 0.5 * o.bodyWidthMm});
+    const double body =
+        boxDistance({a - bodyMid, l, s}, {bodyHalf, 0.5 * o.bodyWidthMm, 0.5 * o.bodyWidthMm});
     const double pegEnd = t.shoulderMm + kPegOverlapMm;
     const double pegMid = 0.5 * (t.pegTipMm + pegEnd), pegHalf = 0.5 * (pegEnd - t.pegTipMm);
     const double peg = boxDistance({a - pegMid, l, s}, {pegHalf, 0.5 * pegLongMm(o), 0.5 * pegShortMm(o)});
@@ -132,8 +139,9 @@ std::string tenonObstruction(const zome::Structure& frame, const Tenon& t, const
     return {};
 }
 
-std::vector<TenonCandidate> findTenonCandidates(const zome::Structure& frame, const Transform4d& frameToGridMm,
-                                                const ShellProbe& probe, const TenonOptions& o) {
+std::vector<TenonCandidate> findTenonCandidates(const zome::Structure& frame,
+                                                const Transform4d& frameToGridMm, const ShellProbe& probe,
+                                                const TenonOptions& o) {
     std::vector<TenonCandidate> out;
     const double voxel = probe.voxelMm;
     const double step = 0.5 * voxel;
@@ -230,7 +238,8 @@ std::vector<TenonCandidate> findTenonCandidates(const zome::Structure& frame, co
                         }
                     }
                     const Vec3d e = add(t.pointAt(t.endMm), offset);
-                    if (!(probe.signedDistanceMm(e) < -0.5 * voxel) || probe.pieceAt(e) != c.piece) isEndOutside = true;
+                    if (!(probe.signedDistanceMm(e) < -0.5 * voxel) || probe.pieceAt(e) != c.piece)
+                        isEndOutside = true;
                 }
             }
             if (crossesOther) {
@@ -248,7 +257,8 @@ std::vector<TenonCandidate> findTenonCandidates(const zome::Structure& frame, co
     return out;
 }
 
-TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, size_t pieceCount, const TenonOptions& o) {
+TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, size_t pieceCount,
+                       const TenonOptions& o) {
     TenonPlan plan;
     plan.perPiece.assign(pieceCount, {});
     plan.shortfall.assign(pieceCount, {});

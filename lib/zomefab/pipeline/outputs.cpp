@@ -33,15 +33,19 @@ std::vector<std::string> writeRunOutputs(const report::RunRecord& run, const Run
     });
     std::error_code ec;
     if (!std::filesystem::create_directory(staged.file("pieces"), ec))
-        throw Error(ErrorCode::WriteFailed, "cannot create the directory: " + ec.message(), staged.file("pieces"));
-    pieces::writePieceFiles(run.pieces, staged.file("pieces"), {run.sourceName, "frame.json", "partition.json"});
+        throw Error(ErrorCode::WriteFailed, "cannot create the directory: " + ec.message(),
+                    staged.file("pieces"));
+    pieces::writePieceFiles(run.pieces, staged.file("pieces"),
+                            {run.sourceName, "frame.json", "partition.json"});
     written.push_back("pieces/");
     // The 3MF holds every piece: one file to open in a slicer, next to the preview, not among the STLs.
     pieces::writePiecesThreeMf(run.pieces, staged.file("pieces.3mf"));
     written.push_back("pieces.3mf");
     report::writePreview(report::previewInput(run), staged.file("preview.glb"), options.preview);
     written.push_back("preview.glb");
-    write("assembly.md", [&](std::ostream& out) { out << report::assemblyGuideMarkdown(run.assembly, options.cost.prices); });
+    write("assembly.md", [&](std::ostream& out) {
+        out << report::assemblyGuideMarkdown(run.assembly, options.cost.prices);
+    });
     write("cost.md", [&](std::ostream& out) { out << report::costPage(run); });
     write(kRunMarkerFile, [&](std::ostream& out) { out << report.dump(2) << '\n'; });
     staged.commit();

@@ -31,7 +31,9 @@ auto aboutInput(const std::string& sourceName, Body&& body) {
     try {
         return body();
     } catch (const Error& e) {
-        if (e.code() == ErrorCode::Usage || e.code() == ErrorCode::Cancelled || e.code() == ErrorCode::Internal) throw;
+        if (e.code() == ErrorCode::Usage || e.code() == ErrorCode::Cancelled ||
+            e.code() == ErrorCode::Internal)
+            throw;
         throw e.withFile(sourceName);
     }
 }
@@ -40,7 +42,8 @@ auto aboutInput(const std::string& sourceName, Body&& body) {
 void levelSets(report::RunRecord& run, const RunOptions& options, RunContext& context) {
     run.field = timedStage("level sets", run, context, [&] {
         return aboutInput(run.sourceName, [&] {
-            sdf::ObjectField field = sdf::makeObjectField(run.scaled.mesh, run.fabrication, options.field, context);
+            sdf::ObjectField field =
+                sdf::makeObjectField(run.scaled.mesh, run.fabrication, options.field, context);
             for (sdf::LevelSet* levelSet : {&field.object, &field.interior}) {
                 levelSet->info().sourceFile = run.sourceName;
                 levelSet->info().generator = generatorString();
@@ -60,10 +63,13 @@ void levelSets(report::RunRecord& run, const RunOptions& options, RunContext& co
 void buildFrame(report::RunRecord& run, const RunOptions& options, RunContext& context) {
     const sdf::InteriorField interior = sdf::makeInteriorField(run.field.interior, context);
     run.frame = timedStage("frame", run, context, [&] {
-        return aboutInput(run.sourceName, [&] { return frame::buildFrame(interior, run.fabrication, options.frame, context); });
+        return aboutInput(run.sourceName, [&] {
+            return frame::buildFrame(interior, run.fabrication, options.frame, context);
+        });
     });
     run.frameTransformMm = frame::frameTransformMm(run.scaled.transformMm, run.frame.rotationDeg);
-    const frame::FrameField field(interior, run.frame.rotationDeg, run.frame.structure.scale(), run.frame.zone);
+    const frame::FrameField field(interior, run.frame.rotationDeg, run.frame.structure.scale(),
+                                  run.frame.zone);
     run.frameMetrics = frame::measureFrame(run.frame.structure, field, options.frame.surfaceSampleSpacingMm);
 }
 
@@ -84,16 +90,16 @@ void partitionSurface(report::RunRecord& run, const RunOptions& options, RunCont
 void makePieces(report::RunRecord& run, const RunOptions& options, RunContext& context) {
     run.pieces = timedStage("pieces", run, context, [&] {
         const Transform4d frameToGridMm = run.shell.info().transformMm * affineInverse(run.frameTransformMm);
-        return pieces::makePieces(run.shell, run.frame.structure, frameToGridMm, run.partition, run.fabrication,
-                                  options.pieces, context);
+        return pieces::makePieces(run.shell, run.frame.structure, frameToGridMm, run.partition,
+                                  run.fabrication, options.pieces, context);
     });
 }
 
 /// Stage 7: what the user reads (paper §7): the assembly guide and the cost report (Table 1).
 void reportRun(report::RunRecord& run, const RunOptions& options, RunContext& context) {
     report::RunReports reports = timedStage("report", run, context, [&] {
-        return report::reportStage(run.frame.structure, run.pieces, run.scaled.mesh, run.fabrication, options.cost,
-                                   context);
+        return report::reportStage(run.frame.structure, run.pieces, run.scaled.mesh, run.fabrication,
+                                   options.cost, context);
     });
     run.assembly = std::move(reports.assembly);
     run.cost = std::move(reports.cost);
@@ -113,9 +119,10 @@ void checkRunOptions(const RunOptions& options) {
     // The pieces stage would find this out only after the level sets; say it before any work.
     const double maxVoxelMm = pieces::maxVoxelForPegsMm(options.pieces.tenons);
     if (options.pieces.tenons.maxPerPiece > 0 && options.field.voxelMm > maxVoxelMm)
-        throw Error(ErrorCode::Usage, "--voxel-mm " + formatNumbers("%g", options.field.voxelMm) + ": the tenon pegs (" +
-                                          formatNumbers("%.2f", pieces::pegShortMm(options.pieces.tenons)) +
-                                          " mm thick) need a voxel of at most " + formatNumbers("%.2f", maxVoxelMm) + " mm");
+        throw Error(ErrorCode::Usage,
+                    "--voxel-mm " + formatNumbers("%g", options.field.voxelMm) + ": the tenon pegs (" +
+                        formatNumbers("%.2f", pieces::pegShortMm(options.pieces.tenons)) +
+                        " mm thick) need a voxel of at most " + formatNumbers("%.2f", maxVoxelMm) + " mm");
     report::checkCostOptions(options.cost);
 }
 

@@ -24,7 +24,7 @@
 namespace zomefab::pipeline {
 
 struct RunOptions {
-    Fabrication fabrication;                ///< printer, wall, frame clearance, b0, seed
+    Fabrication fabrication;  ///< printer, wall, frame clearance, b0, seed
     mesh::ValidateOptions validate;
     mesh::ScaleOptions scale;
     sdf::ObjectFieldOptions field;          ///< voxel sizes of the level sets
@@ -49,9 +49,9 @@ inline constexpr const char* kRunMarkerFile = "report.json";
 
 /// Writes every output file of @p run into @p outDir (frame.json, frame.vef, partition.json,
 /// pieces/ with piece-NN.stl and pieces.json, pieces.3mf, preview.glb, assembly.md, cost.md,
-/// report.json = @p report, report::runReportJson) through a staging directory, so a failure leaves no half-written directory (an
-/// existing output directory of zomefab is replaced; any other existing non-empty directory is
-/// refused). The same writers as the stage tools, so a chain of them writes the same bytes.
+/// report.json = @p report, report::runReportJson) through a staging directory, so a failure leaves no
+/// half-written directory (an existing output directory of zomefab is replaced; any other existing non-empty
+/// directory is refused). The same writers as the stage tools, so a chain of them writes the same bytes.
 /// Returns the file names written, sorted. @throw Error(WriteFailed)
 std::vector<std::string> writeRunOutputs(const report::RunRecord& run, const RunOptions& options,
                                          const nlohmann::json& report, const std::string& outDir);

@@ -67,8 +67,8 @@ void checkCostOptions(const CostOptions& options) {
 }
 
 CostReport costReport(const TriMesh& objectMm, const std::vector<const TriMesh*>& piecesMm,
-                      const zome::PartsList& parts, const Fabrication& fabrication, const CostOptions& options,
-                      RunContext& context) {
+                      const zome::PartsList& parts, const Fabrication& fabrication,
+                      const CostOptions& options, RunContext& context) {
     checkFabrication(fabrication);
     checkCostOptions(options);
     CostReport report;

@@ -90,14 +90,14 @@ void checkCostOptions(const CostOptions& options);
 
 /// Builds the report. @p objectMm is the closed input object in mm as it would be printed whole
 /// (z up); @p piecesMm the closed pieces as they will be printed (print orientation); @p parts the
-/// frame's parts list; the baseline is cut for the Fabrication's printer. With EstimateSource::PrusaSlicer every piece and baseline part is sliced
-/// (2 × (pieces + parts) slicer runs; progress through @p context); a part the slicer fails on is
-/// estimated instead, with a warning, and listed in CostReport::slicerFallbacks.
+/// frame's parts list; the baseline is cut for the Fabrication's printer. With EstimateSource::PrusaSlicer
+/// every piece and baseline part is sliced (2 × (pieces + parts) slicer runs; progress through @p context); a
+/// part the slicer fails on is estimated instead, with a warning, and listed in CostReport::slicerFallbacks.
 /// @throw Error(Usage) for invalid options or a slicer that is not installed, as octreeParts(),
 ///   Error(Cancelled).
 CostReport costReport(const TriMesh& objectMm, const std::vector<const TriMesh*>& piecesMm,
-                      const zome::PartsList& parts, const Fabrication& fabrication, const CostOptions& options = {},
-                      RunContext& context = RunContext::silent());
+                      const zome::PartsList& parts, const Fabrication& fabrication,
+                      const CostOptions& options = {}, RunContext& context = RunContext::silent());
 
 /// The report as JSON (report.json's "cost" block): every number with its unit in the key.
 nlohmann::json costReportToJson(const CostReport& report);

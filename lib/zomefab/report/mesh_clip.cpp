@@ -150,6 +150,87 @@ void earClip(const std::vector<CapVertex>& poly, std::vector<Triangle>& out) {
     out.push_back({poly[prev[i]].id, poly[i].id, poly[next[i]].id});
 }
 
+/// Closes the cut with caps: chains the cap edges (from → to, cut vertices numbered from
+/// @p firstCut in @p out) into loops, sorts them into outer loops and holes in the plane's 2-D
+/// frame, bridges each hole into the smallest outer loop holding it, and ear-clips.
+/// @throw Error(InvalidInput) when the cut does not close into loops.
+void capCut(TriMesh& out, const std::vector<std::pair<uint32_t, uint32_t>>& capEdges, uint32_t firstCut,
+            int axis, double c, bool keepBelow) {
+    // Chain the cap edges into loops: every cut vertex starts exactly one edge and ends one.
+    const size_t cutCount = out.positions.size() - firstCut;
+    std::vector<uint32_t> nextOf(cutCount, UINT32_MAX);
+    std::vector<uint32_t> incoming(cutCount, 0);
+    auto openCut = [&](const char* why) {
+        char at[64];
+        std::snprintf(at, sizeof at, " (cut at %c = %.4f mm)", "xyz"[axis], c);
+        throw Error(ErrorCode::InvalidInput, std::string("mesh is not closed: ") + why + at);
+    };
+    for (const auto& [from, to] : capEdges) {
+        if (nextOf[from - firstCut] != UINT32_MAX) openCut("a cut edge is shared by more than two triangles");
+        nextOf[from - firstCut] = to;
+        ++incoming[to - firstCut];
+    }
+    for (size_t i = 0; i < cutCount; ++i)
+        if (nextOf[i] == UINT32_MAX || incoming[i] != 1) openCut("the cut does not close into loops");
+
+    // 2-D frame of the cap in which its outward normal (towards the removed side) points at the
+    // viewer, so outer loops run counter-clockwise and holes clockwise.
+    const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
+    const bool swapUv = !keepBelow;
+    std::vector<std::vector<CapVertex>> outers, holes;
+    std::vector<double> outerAreas;
+    std::vector<char> visited(cutCount, 0);
+    for (size_t start = 0; start < cutCount; ++start) {
+        if (visited[start]) continue;
+        std::vector<CapVertex> loop;
+        for (uint32_t at = uint32_t(start); !visited[at]; at = nextOf[at] - firstCut) {
+            visited[at] = 1;
+            const Vec3f& p = out.positions[firstCut + at];
+            double u = p[size_t(ua)], v = p[size_t(va)];
+            if (swapUv) std::swap(u, v);
+            loop.push_back({u, v, firstCut + at});
+        }
+        const double area = signedArea(loop);
+        if (loop.size() < 3 || area == 0.0) {
+            // A sliver loop with no area: fan it so its edges are still matched.
+            for (size_t k = 1; k + 1 < loop.size(); ++k)
+                out.triangles.push_back({loop[0].id, loop[k].id, loop[k + 1].id});
+            continue;
+        }
+        if (area > 0.0) {
+            outers.push_back(std::move(loop));
+            outerAreas.push_back(area);
+        } else {
+            holes.push_back(std::move(loop));
+        }
+    }
+    // Each hole goes into the smallest outer loop that contains it; then holes are bridged in
+    // order of their rightmost vertex, rightmost first (Eberly §5).
+    std::vector<std::vector<size_t>> holesOf(outers.size());
+    for (size_t h = 0; h < holes.size(); ++h) {
+        size_t best = outers.size();
+        const CapVertex& probe = holes[h][0];
+        for (size_t o = 0; o < outers.size(); ++o)
+            if ((best == outers.size() || outerAreas[o] < outerAreas[best]) &&
+                contains(outers[o], probe.u, probe.v))
+                best = o;
+        if (best == outers.size()) capFailed("a hole of the cross-section lies outside every outer loop");
+        holesOf[best].push_back(h);
+    }
+    auto rightmost = [](const std::vector<CapVertex>& loop) {
+        double u = -1e300;
+        for (const CapVertex& p : loop) u = std::max(u, p.u);
+        return u;
+    };
+    for (size_t o = 0; o < outers.size(); ++o) {
+        std::vector<size_t>& hs = holesOf[o];
+        std::stable_sort(hs.begin(), hs.end(),
+                         [&](size_t a, size_t b) { return rightmost(holes[a]) > rightmost(holes[b]); });
+        for (size_t h : hs) bridgeHole(outers[o], holes[h]);
+        earClip(outers[o], out.triangles);
+    }
+}
+
 }  // namespace
 
 TriMesh clipByPlane(const TriMesh& mesh, int axis, double coordMm, bool keepBelow) {
@@ -231,79 +312,7 @@ TriMesh clipByPlane(const TriMesh& mesh, int axis, double coordMm, bool keepBelo
     }
     if (capEdges.empty()) return out;
 
-    // Chain the cap edges into loops: every cut vertex starts exactly one edge and ends one.
-    const size_t cutCount = out.positions.size() - firstCut;
-    std::vector<uint32_t> nextOf(cutCount, UINT32_MAX);
-    std::vector<uint32_t> incoming(cutCount, 0);
-    auto openCut = [&](const char* why) {
-        char at[64];
-        std::snprintf(at, sizeof at, " (cut at %c = %.4f mm)", "xyz"[axis], c);
-        throw Error(ErrorCode::InvalidInput, std::string("mesh is not closed: ") + why + at);
-    };
-    for (const auto& [from, to] : capEdges) {
-        if (nextOf[from - firstCut] != UINT32_MAX) openCut("a cut edge is shared by more than two triangles");
-        nextOf[from - firstCut] = to;
-        ++incoming[to - firstCut];
-    }
-    for (size_t i = 0; i < cutCount; ++i)
-        if (nextOf[i] == UINT32_MAX || incoming[i] != 1) openCut("the cut does not close into loops");
-
-    // 2-D frame of the cap in which its outward normal (towards the removed side) points at the
-    // viewer, so outer loops run counter-clockwise and holes clockwise.
-    const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
-    const bool swapUv = !keepBelow;
-    std::vector<std::vector<CapVertex>> outers, holes;
-    std::vector<double> outerAreas;
-    std::vector<char> visited(cutCount, 0);
-    for (size_t start = 0; start < cutCount; ++start) {
-        if (visited[start]) continue;
-        std::vector<CapVertex> loop;
-        for (uint32_t at = uint32_t(start); !visited[at]; at = nextOf[at] - firstCut) {
-            visited[at] = 1;
-            const Vec3f& p = out.positions[firstCut + at];
-            double u = p[size_t(ua)], v = p[size_t(va)];
-            if (swapUv) std::swap(u, v);
-            loop.push_back({u, v, firstCut + at});
-        }
-        const double area = signedArea(loop);
-        if (loop.size() < 3 || area == 0.0) {
-            // A sliver loop with no area: fan it so its edges are still matched.
-            for (size_t k = 1; k + 1 < loop.size(); ++k)
-                out.triangles.push_back({loop[0].id, loop[k].id, loop[k + 1].id});
-            continue;
-        }
-        if (area > 0.0) {
-            outers.push_back(std::move(loop));
-            outerAreas.push_back(area);
-        } else {
-            holes.push_back(std::move(loop));
-        }
-    }
-    // Each hole goes into the smallest outer loop that contains it; then holes are bridged in
-    // order of their rightmost vertex, rightmost first (Eberly §5).
-    std::vector<std::vector<size_t>> holesOf(outers.size());
-    for (size_t h = 0; h < holes.size(); ++h) {
-        size_t best = outers.size();
-        const CapVertex& probe = holes[h][0];
-        for (size_t o = 0; o < outers.size(); ++o)
-            if ((best == outers.size() || outerAreas[o] < outerAreas[best]) &&
-                contains(outers[o], probe.u, probe.v))
-                best = o;
-        if (best == outers.size()) capFailed("a hole of the cross-section lies outside every outer loop");
-        holesOf[best].push_back(h);
-    }
-    auto rightmost = [](const std::vector<CapVertex>& loop) {
-        double u = -1e300;
-        for (const CapVertex& p : loop) u = std::max(u, p.u);
-        return u;
-    };
-    for (size_t o = 0; o < outers.size(); ++o) {
-        std::vector<size_t>& hs = holesOf[o];
-        std::stable_sort(hs.begin(), hs.end(),
-                         [&](size_t a, size_t b) { return rightmost(holes[a]) > rightmost(holes[b]); });
-        for (size_t h : hs) bridgeHole(outers[o], holes[h]);
-        earClip(outers[o], out.triangles);
-    }
+    capCut(out, capEdges, firstCut, axis, c, keepBelow);
     return out;
 }
 
@@ -320,7 +329,6 @@ TriMesh clipToBox(const TriMesh& mesh, const Box3d& box) {
     }
     return part;
 }
-
 
 double meshAreaMm2(const TriMesh& m) {
     double s = 0.0;

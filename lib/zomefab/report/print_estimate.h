@@ -109,5 +109,4 @@ std::vector<TriMesh> octreeParts(const TriMesh& object, const Vec3d& printerMm, 
 /// ties and parts without flat faces keep their orientation. Rotations are exact (axis swaps).
 TriMesh orientOnBed(const TriMesh& part, const Vec3d& printerMm);
 
-
 }  // namespace zomefab::report

@@ -28,16 +28,16 @@ struct StageTiming {
 };
 
 struct RunRecord {
-    std::string sourceName;            ///< the input file as given ("-" = stdin)
-    Fabrication fabrication;           ///< what the run made
-    mesh::MeshReport inputReport;      ///< checks of the input as read (file units)
-    mesh::ScaledMesh scaled;           ///< the object in mm, z up, with transform_mm
-    sdf::ObjectField field;            ///< "object" and "interior" level sets
-    sdf::LevelSet shell;               ///< the hollow shell
-    frame::FrameResult frame;          ///< the frame (structure in frame mm)
-    Transform4d frameTransformMm;      ///< input coordinates → frame mm
+    std::string sourceName;        ///< the input file as given ("-" = stdin)
+    Fabrication fabrication;       ///< what the run made
+    mesh::MeshReport inputReport;  ///< checks of the input as read (file units)
+    mesh::ScaledMesh scaled;       ///< the object in mm, z up, with transform_mm
+    sdf::ObjectField field;        ///< "object" and "interior" level sets
+    sdf::LevelSet shell;           ///< the hollow shell
+    frame::FrameResult frame;      ///< the frame (structure in frame mm)
+    Transform4d frameTransformMm;  ///< input coordinates → frame mm
     frame::FrameMetrics frameMetrics;
-    TriMesh surfaceFrameMm;            ///< the scaled surface in the frame's coordinates
+    TriMesh surfaceFrameMm;  ///< the scaled surface in the frame's coordinates
     partition::PartitionResult partition;
     pieces::Pieces pieces;             ///< printable pieces, in printer coordinates
     AssemblyGuide assembly;            ///< build order of the frame and the pieces' tenons

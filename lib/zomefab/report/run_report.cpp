@@ -26,26 +26,31 @@ std::string frameLine(const RunRecord& run) {
     const Vec3d& size = run.scaled.sizeMm;
     return formatNumbers("%.0f x %.0f x %.0f mm", size[0], size[1], size[2]) + ": frame of " +
            std::to_string(parts.balls) + " balls and " + std::to_string(parts.strutTotal()) + " struts (" +
-           std::to_string(run.assembly.layers) + " layers to build), " + std::to_string(run.pieces.pieces.size()) +
-           " printed pieces with " + std::to_string(tenons) + " tenons" +
+           std::to_string(run.assembly.layers) + " layers to build), " +
+           std::to_string(run.pieces.pieces.size()) + " printed pieces with " + std::to_string(tenons) +
+           " tenons" +
            (fewTenons ? " (" + std::to_string(fewTenons) + " pieces with fewer than planned)" : "");
 }
 
 std::string costLine(const CostCase& c) {
     return c.name + formatNumbers(" (%.0f%% infill): ", c.infillPercent) +
-           formatNumbers("print %.1f h, %.2f kg, %.2f USD", c.zomefab.print.hours(), c.zomefab.filament.massG / 1000.0,
-                         c.zomefab.filament.costUsd) +
-           formatNumbers(" + Zometool %.2f USD, %.1f h to build", c.zomefab.zomeUsd, c.zomefab.assemblyHours) +
+           formatNumbers("print %.1f h, %.2f kg, %.2f USD", c.zomefab.print.hours(),
+                         c.zomefab.filament.massG / 1000.0, c.zomefab.filament.costUsd) +
+           formatNumbers(" + Zometool %.2f USD, %.1f h to build", c.zomefab.zomeUsd,
+                         c.zomefab.assemblyHours) +
            formatNumbers("; whole object %.1f h, %.2f USD", c.baseline.print.hours(), c.baseline.totalUsd()) +
            formatNumbers(": saves %.0f%% time, %.0f%% material", c.savedTimePercent, c.savedMaterialPercent);
 }
 
 json levelSetsJson(const RunRecord& run) {
-    return {{"object", {{"voxel_mm", run.field.object.info().voxelMm},
-                        {"active_voxels", run.field.object.activeVoxelCount()}}},
-            {"interior", {{"voxel_mm", run.field.interior.info().voxelMm},
-                          {"active_voxels", run.field.interior.activeVoxelCount()}}},
-            {"shell", {{"shell_mm", run.fabrication.wallMm}, {"active_voxels", run.shell.activeVoxelCount()}}}};
+    return {
+        {"object",
+         {{"voxel_mm", run.field.object.info().voxelMm},
+          {"active_voxels", run.field.object.activeVoxelCount()}}},
+        {"interior",
+         {{"voxel_mm", run.field.interior.info().voxelMm},
+          {"active_voxels", run.field.interior.activeVoxelCount()}}},
+        {"shell", {{"shell_mm", run.fabrication.wallMm}, {"active_voxels", run.shell.activeVoxelCount()}}}};
 }
 
 json frameJson(const RunRecord& run) {
@@ -107,7 +112,8 @@ RunReports reportStage(const zome::Structure& frame, const pieces::Pieces& all, 
         const pieces::Piece& piece = all.pieces[i];
         names.push_back(pieces::pieceName(all, i));
         printed.push_back(&piece.mesh);
-        for (const pieces::Tenon& tenon : piece.tenons) links.push_back({names.back(), tenon.ball, tenon.hole});
+        for (const pieces::Tenon& tenon : piece.tenons)
+            links.push_back({names.back(), tenon.ball, tenon.hole});
     }
     RunReports reports;
     reports.assembly = assemblyGuide(frame, links, names);
@@ -135,7 +141,8 @@ json runReportJson(const RunRecord& run, const RunContext& context) {
     report["frame"] = frameJson(run);
     report["partition"] = partitionJson(run);
     report["pieces"] = piecesJson(run);
-    report["assembly"] = {{"layers", run.assembly.layers}, {"components", run.assembly.components}, {"file", "assembly.md"}};
+    report["assembly"] = {
+        {"layers", run.assembly.layers}, {"components", run.assembly.components}, {"file", "assembly.md"}};
     report["cost"] = costJson(run);
     json timings = json::array();
     for (const StageTiming& t : run.timings) timings.push_back({{"stage", t.stage}, {"seconds", t.seconds}});
@@ -147,7 +154,8 @@ json runReportJson(const RunRecord& run, const RunContext& context) {
 }
 
 std::string costPage(const RunRecord& run) {
-    std::string page = "# Cost and time: " + std::filesystem::path(run.sourceName).filename().string() + "\n\n";
+    std::string page =
+        "# Cost and time: " + std::filesystem::path(run.sourceName).filename().string() + "\n\n";
     for (const std::string& line : runSummaryLines(run)) page += "- " + line + "\n";
     return page + "\n" + costReportMarkdown(run.cost);
 }
@@ -177,7 +185,8 @@ PreviewInput previewInput(const RunRecord& run) {
 
 RunSummary runSummaryFromJson(const json& report) {
     if (!report.is_object() || report.value("format", "") != kReportFormatName)
-        throw Error(ErrorCode::InvalidInput, std::string("not a run report (format is not \"") + kReportFormatName + "\")");
+        throw Error(ErrorCode::InvalidInput,
+                    std::string("not a run report (format is not \"") + kReportFormatName + "\")");
     RunSummary s;
     s.peakRssBytes = report.value("peak_rss_bytes", size_t(0));
     const json frame = report.value("frame", json::object());

@@ -23,8 +23,8 @@ struct ForbiddenZoneOptions {
     /// Nothing of the frame may come closer to the surface (Fabrication::frameClearanceMm).
     double dMinMm = Fabrication{}.frameClearanceMm;
     double dMaxMm = Fabrication{}.frameReachMm();  ///< = b0, the shortest blue strut
-    double fThick = 90.0;  ///< penalty closer than dMin (and outside the object)
-    double fMax = 70.0;    ///< penalty at and beyond dMax
+    double fThick = 90.0;                          ///< penalty closer than dMin (and outside the object)
+    double fMax = 70.0;                            ///< penalty at and beyond dMax
 };
 
 /// The forbidden-zone penalty F for a node @p depthMm inside the surface (negative outside):

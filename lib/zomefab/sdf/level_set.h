@@ -83,10 +83,10 @@ struct MeshToLevelSetOptions {
 
 /// Signed distance to @p meshMm (millimetres, closed, outward triangles).
 /// @throw Error(Usage) for a voxel or band that is not positive and finite, or a voxel too small
-///        for the mesh (more than 2^30 voxels across or about 10^9 in the band); Error(InvalidInput) for an empty mesh, vertex indices
-///        out of range or non-finite coordinates; Error(ProcessingFailed) when the result has no
-///        inside or its inside leaks to the bounding box (an open or badly self-intersecting mesh);
-///        Error(Cancelled) when @p context is cancelled.
+///        for the mesh (more than 2^30 voxels across or about 10^9 in the band); Error(InvalidInput) for an
+///        empty mesh, vertex indices out of range or non-finite coordinates; Error(ProcessingFailed) when the
+///        result has no inside or its inside leaks to the bounding box (an open or badly self-intersecting
+///        mesh); Error(Cancelled) when @p context is cancelled.
 LevelSet meshToLevelSet(const TriMesh& meshMm, const MeshToLevelSetOptions& options, RunContext& context);
 
 /// What zf-sdf builds from the scaled input mesh.
@@ -113,8 +113,8 @@ void checkObjectFieldOptions(const ObjectFieldOptions& options);
 
 /// Both grids of ObjectField from @p meshMm; the "object" grid is exact Fabrication::wallMm deep,
 /// which is what makeShell needs. @throw as checkObjectFieldOptions and meshToLevelSet.
-ObjectField makeObjectField(const TriMesh& meshMm, const Fabrication& fabrication, const ObjectFieldOptions& options,
-                            RunContext& context);
+ObjectField makeObjectField(const TriMesh& meshMm, const Fabrication& fabrication,
+                            const ObjectFieldOptions& options, RunContext& context);
 
 /// The hollow shell {x : −wallMm ≤ φ(x) ≤ 0} (paper §6) of Fabrication::wallMm: csgDifference of
 /// @p object and its inward offset {φ < −wallMm}, the offset read from the object's deep interior

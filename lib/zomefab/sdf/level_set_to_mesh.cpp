@@ -3,7 +3,6 @@
 #include <openvdb/tools/VolumeToMesh.h>
 
 #include <cmath>
-#include <sstream>
 
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
@@ -11,12 +10,44 @@
 
 namespace zomefab::sdf {
 
-namespace {
-
-double squaredDistance(const openvdb::Vec3s& a, const openvdb::Vec3s& b) { return (a - b).lengthSqr(); }
-
-
-}  // namespace
+TriMesh meshFloatGrid(const openvdb::FloatGrid& grid, const LevelSetToMeshOptions& options,
+                      const openvdb::BoolTree::Ptr& fullResolution) {
+    openvdb::tools::VolumeToMesh mesher(options.isoMm, options.adaptivity,
+                                        /*relaxDisorientedTriangles=*/true);
+    if (fullResolution) mesher.setAdaptivityMask(fullResolution);
+    mesher(grid);
+    TriMesh mesh;
+    const openvdb::tools::PointList& points = mesher.pointList();
+    mesh.positions.resize(mesher.pointListSize());
+    for (size_t i = 0; i < mesh.positions.size(); ++i)
+        mesh.positions[i] = {points[i][0], points[i][1], points[i][2]};
+    auto d2 = [&](uint32_t a, uint32_t b) { return (points[a] - points[b]).lengthSqr(); };
+    const openvdb::tools::PolygonPoolList& pools = mesher.polygonPoolList();
+    for (size_t n = 0; n < mesher.polygonPoolListSize(); ++n) {
+        const openvdb::tools::PolygonPool& pool = pools[n];
+        for (size_t i = 0; i < pool.numQuads(); ++i) {
+            const openvdb::Vec4I& q = pool.quad(i);
+            if (d2(q[0], q[2]) <= d2(q[1], q[3])) {
+                mesh.triangles.push_back({q[0], q[2], q[1]});
+                mesh.triangles.push_back({q[0], q[3], q[2]});
+            } else {
+                mesh.triangles.push_back({q[0], q[3], q[1]});
+                mesh.triangles.push_back({q[1], q[3], q[2]});
+            }
+        }
+        for (size_t i = 0; i < pool.numTriangles(); ++i) {
+            const openvdb::Vec3I& t = pool.triangle(i);
+            mesh.triangles.push_back({t[0], t[2], t[1]});
+        }
+    }
+    if (options.minComponentVolumeMm3 > 0) {
+        const VertexComponents components = vertexComponents(mesh);
+        keepComponents(mesh, components, [&](uint32_t root) {
+            return std::abs(components.volume[root]) >= options.minComponentVolumeMm3;
+        });
+    }
+    return mesh;
+}
 
 void checkMeshingOptions(const LevelSetToMeshOptions& options) {
     if (!(options.minComponentVolumeMm3 >= 0))
@@ -45,39 +76,8 @@ TriMesh levelSetToMesh(const LevelSet& levelSet, const LevelSetToMeshOptions& op
     context.throwIfCancelled();
     context.progress("mesh", 0.0);
 
-    std::vector<openvdb::Vec3s> points;
-    std::vector<openvdb::Vec3I> triangles;
-    std::vector<openvdb::Vec4I> quads;
-    openvdb::tools::volumeToMesh(*grid, points, triangles, quads, options.isoMm, options.adaptivity,
-                                 /*relaxDisorientedTriangles=*/true);
+    TriMesh mesh = meshFloatGrid(*grid, options);
     context.throwIfCancelled();
-
-    TriMesh mesh;
-    mesh.positions.resize(points.size());
-    for (size_t i = 0; i < points.size(); ++i) mesh.positions[i] = {points[i][0], points[i][1], points[i][2]};
-    mesh.triangles.reserve(triangles.size() + 2 * quads.size());
-    // OpenVDB winds its polygons clockwise seen from φ > iso (Houdini's convention); zomefab's
-    // meshes are counter-clockwise from outside, so every polygon is reversed.
-    for (const openvdb::Vec3I& t : triangles) mesh.triangles.push_back({t[0], t[2], t[1]});
-    for (const openvdb::Vec4I& q : quads) {
-        // Split along the shorter diagonal: better-shaped triangles, and a deterministic choice.
-        if (squaredDistance(points[q[0]], points[q[2]]) <= squaredDistance(points[q[1]], points[q[3]])) {
-            mesh.triangles.push_back({q[0], q[2], q[1]});
-            mesh.triangles.push_back({q[0], q[3], q[2]});
-        } else {
-            mesh.triangles.push_back({q[0], q[3], q[1]});
-            mesh.triangles.push_back({q[1], q[3], q[2]});
-        }
-    }
-    if (options.minComponentVolumeMm3 > 0) {
-        const VertexComponents components = vertexComponents(mesh);
-        const size_t dropped = keepComponents(mesh, components, [&](uint32_t root) {
-            return std::abs(components.volume[root]) >= options.minComponentVolumeMm3;
-        });
-        if (dropped > 0)
-            context.debug("dropped " + std::to_string(dropped) + " surface fragments enclosing less than " +
-                          formatNumber(options.minComponentVolumeMm3) + " mm³");
-    }
     context.progress("mesh", 1.0);
     if (mesh.triangles.empty())
         throw Error(ErrorCode::ProcessingFailed,

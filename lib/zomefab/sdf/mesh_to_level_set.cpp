@@ -159,7 +159,8 @@ LevelSet meshToLevelSet(const TriMesh& mesh, const MeshToLevelSetOptions& option
     if (insideVolume < 0.5 * meshVolume) {
         throw Error(ErrorCode::ProcessingFailed,
                     "the level set's inside (" + formatNumber(std::round(insideVolume)) +
-                        " mm³) is far smaller than the mesh's volume (" + formatNumber(std::round(meshVolume)) +
+                        " mm³) is far smaller than the mesh's volume (" +
+                        formatNumber(std::round(meshVolume)) +
                         " mm³): the mesh is not closed or it self-intersects, so the inside leaked out");
     }
 
@@ -178,8 +179,8 @@ void checkObjectFieldOptions(const ObjectFieldOptions& options) {
         throw Error(ErrorCode::Usage, "the interior field's exterior band must be ≥ 0 mm");
 }
 
-ObjectField makeObjectField(const TriMesh& meshMm, const Fabrication& fabrication, const ObjectFieldOptions& options,
-                            RunContext& context) {
+ObjectField makeObjectField(const TriMesh& meshMm, const Fabrication& fabrication,
+                            const ObjectFieldOptions& options, RunContext& context) {
     checkFabrication(fabrication);
     checkObjectFieldOptions(options);
     ObjectField field;

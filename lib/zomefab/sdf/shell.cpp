@@ -52,12 +52,11 @@ LevelSet makeShell(const LevelSet& object, const Fabrication& fabrication, RunCo
     const double wallMm = fabrication.wallMm;
     const LevelSetInfo& source = object.info();
     if (wallMm > source.interiorBandMm * (1 + 1e-9)) {
-        throw Error(ErrorCode::Usage, "a " + formatNumber(wallMm) +
-                                          " mm shell needs exact distances that deep, but the '" +
-                                          source.name + "' grid's interior band reaches " +
-                                          formatNumber(source.interiorBandMm) +
-                                          " mm; rebuild it with a deeper band (zf-sdf --shell-mm " +
-                                          formatNumber(wallMm) + ")");
+        throw Error(
+            ErrorCode::Usage,
+            "a " + formatNumber(wallMm) + " mm shell needs exact distances that deep, but the '" +
+                source.name + "' grid's interior band reaches " + formatNumber(source.interiorBandMm) +
+                " mm; rebuild it with a deeper band (zf-sdf --shell-mm " + formatNumber(wallMm) + ")");
     }
     const openvdb::FloatGrid::ConstPtr grid = levelSetGrid(object);
     const double voxel = grid->voxelSize()[0];

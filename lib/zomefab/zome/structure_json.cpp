@@ -7,8 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "zomefab/core/json_values.h"
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
+#include "zomefab/core/json_values.h"
 #include "zomefab/core/version.h"
 
 namespace zomefab::zome {
@@ -57,6 +58,62 @@ GoldenVector3 readExact(const json& j, const std::string& who) {
     return v;
 }
 
+/// Reads strut @p i and adds it to @p s, checking what the file declares against the exact vector.
+void addStrutFromJson(Structure& s, const json& st, size_t i) {
+    const std::string where = "strut " + std::to_string(i);
+    if (!st.is_object()) fail(where + " is not an object");
+    const json* ja = member(st, "a");
+    const json* jb = member(st, "b");
+    if (!ja || !jb) fail(where + ": needs ball ids \"a\" and \"b\"");
+    const int64_t a = requireInt(*ja, where + ": a");
+    const int64_t b = requireInt(*jb, where + ": b");
+    for (int64_t end : {a, b})
+        if (end < 0 || end >= int64_t(s.ballIdBound()) || !s.hasBall(BallId(end)))
+            fail(where + ": unknown ball id " + std::to_string(end));
+    const std::string who = where + " (" + ballLabel(a) + " to " + ballLabel(b) + ")";
+    if (a == b) fail(who + ": both ends are the same ball");
+    const GoldenVector3 v = s.ball(BallId(b)).position - s.ball(BallId(a)).position;
+    const std::optional<StrutMatch> m = matchStrut(v);
+    if (!m) {
+        std::string why = "vector " + v.toString() + " is not a Zome strut";
+        if (const std::optional<int> h = parallelHole(v))
+            why += " (parallel to hole " + std::to_string(*h) + " but not a " + colorName(holeColor(*h)) +
+                   " catalogue length)";
+        fail(who + ": " + why);
+    }
+    if (const json* c = member(st, "color")) {
+        if (!c->is_string() || !colorFromName(c->get<std::string>()))
+            fail(who + ": color must be \"blue\", \"yellow\" or \"red\"");
+        if (*colorFromName(c->get<std::string>()) != m->color)
+            fail(who + ": color is " + c->get<std::string>() + " but the vector is a " + describe(*m) +
+                 " strut");
+    }
+    if (const json* z = member(st, "size")) {
+        const int64_t size = requireInt(*z, who + ": size");
+        if (size != m->size)
+            fail(who + ": size is " + std::to_string(size) + " but the vector is a " + describe(*m) +
+                 " strut");
+    }
+    if (const json* h = member(st, "hole_a")) {
+        const int64_t hole = requireInt(*h, who + ": hole_a");
+        if (hole != m->hole)
+            fail(who + ": hole_a is " + std::to_string(hole) + " but the vector leaves " + ballLabel(a) +
+                 " through hole " + std::to_string(m->hole));
+    }
+    if (const json* h = member(st, "hole_b")) {
+        const int64_t hole = requireInt(*h, who + ": hole_b");
+        if (hole != oppositeHole(m->hole))
+            fail(who + ": hole_b is " + std::to_string(hole) + " but the vector enters " + ballLabel(b) +
+                 " through hole " + std::to_string(oppositeHole(m->hole)));
+    }
+    for (const auto& [ball, hole] : {std::pair<int64_t, int>{a, m->hole}, {b, oppositeHole(m->hole)}}) {
+        const StrutId used = s.ball(BallId(ball)).holes[size_t(hole)];
+        if (used != kNoId)
+            fail(who + ": hole " + std::to_string(hole) + " of " + ballLabel(ball) +
+                 " is already used by strut " + std::to_string(used));
+    }
+    s.addStrut(BallId(a), m->hole, m->size);
+}
 
 }  // namespace
 
@@ -200,62 +257,7 @@ Structure structureFromJson(const json& j, const ZomeScale& physical, const Coll
         }
     }
 
-    for (size_t i = 0; i < struts->size(); ++i) {
-        const json& st = (*struts)[i];
-        const std::string where = "strut " + std::to_string(i);
-        if (!st.is_object()) fail(where + " is not an object");
-        const json* ja = member(st, "a");
-        const json* jb = member(st, "b");
-        if (!ja || !jb) fail(where + ": needs ball ids \"a\" and \"b\"");
-        const int64_t a = requireInt(*ja, where + ": a");
-        const int64_t b = requireInt(*jb, where + ": b");
-        for (int64_t end : {a, b})
-            if (end < 0 || end >= int64_t(s.ballIdBound()) || !s.hasBall(BallId(end)))
-                fail(where + ": unknown ball id " + std::to_string(end));
-        const std::string who = where + " (" + ballLabel(a) + " to " + ballLabel(b) + ")";
-        if (a == b) fail(who + ": both ends are the same ball");
-        const GoldenVector3 v = s.ball(BallId(b)).position - s.ball(BallId(a)).position;
-        const std::optional<StrutMatch> m = matchStrut(v);
-        if (!m) {
-            std::string why = "vector " + v.toString() + " is not a Zome strut";
-            if (const std::optional<int> h = parallelHole(v))
-                why += " (parallel to hole " + std::to_string(*h) + " but not a " + colorName(holeColor(*h)) +
-                       " catalogue length)";
-            fail(who + ": " + why);
-        }
-        if (const json* c = member(st, "color")) {
-            if (!c->is_string() || !colorFromName(c->get<std::string>()))
-                fail(who + ": color must be \"blue\", \"yellow\" or \"red\"");
-            if (*colorFromName(c->get<std::string>()) != m->color)
-                fail(who + ": color is " + c->get<std::string>() + " but the vector is a " + describe(*m) +
-                     " strut");
-        }
-        if (const json* z = member(st, "size")) {
-            const int64_t size = requireInt(*z, who + ": size");
-            if (size != m->size)
-                fail(who + ": size is " + std::to_string(size) + " but the vector is a " + describe(*m) +
-                     " strut");
-        }
-        if (const json* h = member(st, "hole_a")) {
-            const int64_t hole = requireInt(*h, who + ": hole_a");
-            if (hole != m->hole)
-                fail(who + ": hole_a is " + std::to_string(hole) + " but the vector leaves " + ballLabel(a) +
-                     " through hole " + std::to_string(m->hole));
-        }
-        if (const json* h = member(st, "hole_b")) {
-            const int64_t hole = requireInt(*h, who + ": hole_b");
-            if (hole != oppositeHole(m->hole))
-                fail(who + ": hole_b is " + std::to_string(hole) + " but the vector enters " + ballLabel(b) +
-                     " through hole " + std::to_string(oppositeHole(m->hole)));
-        }
-        for (const auto& [ball, hole] : {std::pair<int64_t, int>{a, m->hole}, {b, oppositeHole(m->hole)}}) {
-            const StrutId used = s.ball(BallId(ball)).holes[size_t(hole)];
-            if (used != kNoId)
-                fail(who + ": hole " + std::to_string(hole) + " of " + ballLabel(ball) +
-                     " is already used by strut " + std::to_string(used));
-        }
-        s.addStrut(BallId(a), m->hole, m->size);
-    }
+    for (size_t i = 0; i < struts->size(); ++i) addStrutFromJson(s, (*struts)[i], i);
     return s;
 }
 
@@ -306,6 +308,45 @@ std::string structureToVef(const Structure& s) {
         if ((i + 1) % 10 == 0) out += "\n";
     }
     out += "\n\n";
+    return out;
+}
+
+json collisionToJson(const Collision& c) {
+    return {{"kind", collisionKindName(c.kind)},
+            {"first", c.first},
+            {"second", c.second},
+            {"distance_mm", c.distanceMm},
+            {"limit_mm", c.limitMm}};
+}
+
+std::string describeCollision(const Collision& c) {
+    const bool strutFirst = c.kind != CollisionKind::BallBall;
+    const bool strutSecond = c.kind == CollisionKind::StrutStrut;
+    return std::string(strutFirst ? "strut " : "ball ") + std::to_string(c.first) + " and " +
+           (strutSecond ? "strut " : "ball ") + std::to_string(c.second) + " (" + collisionKindName(c.kind) +
+           ", " + formatNumbers("%.2f mm < %.2f mm", c.distanceMm, c.limitMm) + ")";
+}
+
+json checkReportJson(const Structure& frame, const std::string& file,
+                     const std::vector<Collision>& collisions, const PriceOptions& prices) {
+    const ZomeScale& scale = frame.scale();
+    json out = {{"file", file},
+                {"valid", true},
+                {"balls", frame.ballCount()},
+                {"struts", frame.strutCount()},
+                {"collision_free", collisions.empty()},
+                {"collision_count", collisions.size()},
+                {"collisions", json::array()},
+                {"parts", partsListToJson(partsList(frame), prices)},
+                {"scale",
+                 {{"b0_mm", scale.b0Mm},
+                  {"unit_mm", scale.unitMm()},
+                  {"ball_diameter_mm", scale.ballDiameterMm},
+                  {"blue_radius_mm", scale.blueRadiusMm},
+                  {"yellow_radius_mm", scale.yellowRadiusMm},
+                  {"red_radius_mm", scale.redRadiusMm},
+                  {"clearance_mm", frame.collisionOptions().clearanceMm}}}};
+    for (const Collision& c : collisions) out["collisions"].push_back(collisionToJson(c));
     return out;
 }
 

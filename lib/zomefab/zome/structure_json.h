@@ -8,6 +8,7 @@
 #include <string>
 
 #include "zomefab/core/transform.h"
+#include "zomefab/zome/parts.h"
 #include "zomefab/zome/structure.h"
 
 namespace zomefab::zome {
@@ -45,5 +46,14 @@ Structure structureFromJsonText(const std::string& text, const ZomeScale& physic
 /// `(0,0) x y z` (w first, each coordinate "(b,a)" for a + bφ, vZome units), every strut an edge
 /// "i j" of vertex indices, no panels, every vertex a ball. Vertices are the live balls in id order.
 std::string structureToVef(const Structure& structure);
+
+/// One collision as JSON: kind, the two ids, distance and limit (mm).
+nlohmann::json collisionToJson(const Collision& collision);
+/// "strut 3 and ball 7 (strut–ball, 10.02 mm < 12.15 mm)".
+std::string describeCollision(const Collision& collision);
+/// zf-zome check's report of @p frame read from @p file: validity, collisions, parts and prices,
+/// the scale and the collision clearance used.
+nlohmann::json checkReportJson(const Structure& frame, const std::string& file,
+                               const std::vector<Collision>& collisions, const PriceOptions& prices);
 
 }  // namespace zomefab::zome

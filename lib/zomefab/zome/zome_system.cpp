@@ -132,7 +132,8 @@ Built build() {
         const Color target = h.color == Color::Red ? Color::Yellow : Color::Red;
         double best = -2.0;
         Vec3d u{};
-        for (int other = kFirstHole[int(target)]; other < kFirstHole[int(target)] + 2 * kAxesOf[int(target)]; ++other) {
+        for (int other = kFirstHole[int(target)]; other < kFirstHole[int(target)] + 2 * kAxesOf[int(target)];
+             ++other) {
             const double c = t.cosine[size_t(hole)][size_t(other)];
             if (c > best + 1e-9) {  // ties (symmetric neighbours): the lowest hole number
                 best = c;

@@ -111,11 +111,11 @@ std::optional<int> parallelHole(const GoldenVector3& v);
 /// (docs/zome.md §3 lists sources).
 struct ZomeScale {
     double b0Mm = Fabrication{}.b0Mm;  ///< B0 centre-to-centre (paper §4.2: b0 = 47.3; vZome nominal 46.27)
-    double ballDiameterMm = 17.7;   ///< ball width across the blue holes (ZomeFab NODE_DIAMETER)
-    double blueRadiusMm = 3.3;      ///< blue capsule radius (5.46 × 3.38 mm rectangle, circumradius 3.21)
-    double yellowRadiusMm = 3.2;    ///< yellow capsule radius (lifelike model max radius 3.15)
-    double redRadiusMm = 2.9;       ///< red capsule radius (lifelike model max radius 2.87)
-    Vec3d originMm{0.0, 0.0, 0.0};  ///< millimetre position of the exact origin (0,0,0)
+    double ballDiameterMm = 17.7;      ///< ball width across the blue holes (ZomeFab NODE_DIAMETER)
+    double blueRadiusMm = 3.3;         ///< blue capsule radius (5.46 × 3.38 mm rectangle, circumradius 3.21)
+    double yellowRadiusMm = 3.2;       ///< yellow capsule radius (lifelike model max radius 3.15)
+    double redRadiusMm = 2.9;          ///< red capsule radius (lifelike model max radius 2.87)
+    Vec3d originMm{0.0, 0.0, 0.0};     ///< millimetre position of the exact origin (0,0,0)
 
     /// One vZome unit in mm: b0Mm / (2φ²) (B0 is 2φ² units); 9.0335 mm by default.
     double unitMm() const;

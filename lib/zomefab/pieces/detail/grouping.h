@@ -1,0 +1,57 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file From voxels to pieces (internal to lib/zomefab/pieces): the connected components of
+/// shell ∩ cell, grouped by the partition's pieces, small ones and shell outside every named cell
+/// merged into a neighbour, the owner of every voxel, and each piece's cells. docs/pieces.md §1.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include "zomefab/core/run_context.h"
+#include "zomefab/partition/partition_result.h"
+#include "zomefab/pieces/detail/voxels.h"
+#include "zomefab/pieces/pieces.h"
+
+namespace zomefab::pieces::detail {
+
+/// One connected component of shell ∩ cell.
+struct Component {
+    uint32_t cell = 0;
+    size_t voxels = 0;
+    uint32_t group = 0;  ///< request index, or requests.size() + component index for an orphan
+};
+
+/// The connected components of the inside voxels (6-neighbours, same cell), numbered in slot
+/// order; every inside voxel's owner becomes its component. Serial, deterministic.
+std::vector<Component> findComponents(VoxelField& field);
+
+/// Voxel faces between inside voxels of different components, per (lower, higher) component.
+std::map<std::pair<uint32_t, uint32_t>, size_t> componentContacts(const VoxelField& field);
+
+/// Each component's group: the partition piece (request) that names its cell; when several do,
+/// the one whose surface box grown by @p growMm holds most of its voxels; when none does, an
+/// orphan group of its own. Returns the volume of the orphans (mm³).
+double assignGroups(std::vector<Component>& comps, const VoxelField& field,
+                    const std::vector<partition::Piece>& requests, size_t cellCount,
+                    const Transform4d& gridToFrame, double growMm, double voxelVolumeMm3);
+
+/// What the grouping made: the pieces (ids, cells, requests, neighbours, slivers, shell volume),
+/// their cell sets, and the merge counts.
+struct Grouping {
+    std::vector<Piece> pieces;
+    std::vector<CellSet> cellSets;
+    double shellVolumeMm3 = 0.0;
+    double outsideCellsVolumeMm3 = 0.0;
+    size_t sliversMerged = 0;
+    size_t isolatedSlivers = 0;
+};
+
+/// The whole grouping (docs/pieces.md §1, steps 2–4): components, groups, merges of orphans and
+/// slivers under @p minPieceVolumeMm3 into the neighbour with the largest cut face, piece order,
+/// the owners of band voxels, cell sets and neighbours. Warnings go to @p context.
+Grouping groupPieces(VoxelField& field, const GridCells& cells, const std::vector<partition::Piece>& requests,
+                     const Transform4d& gridToFrame, double growMm, double minPieceVolumeMm3,
+                     const RunContext& context);
+
+}  // namespace zomefab::pieces::detail

@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file The steps of makePieces after the grouping (internal to lib/zomefab/pieces): the tenons
+/// and numbers planned against the shell, each piece's level set by CSG, and each piece's mesh
+/// checked and turned for the printer. docs/pieces.md §2–5.
+#pragma once
+
+#include <openvdb/openvdb.h>
+
+#include <string>
+#include <vector>
+
+#include "zomefab/core/run_context.h"
+#include "zomefab/pieces/detail/voxels.h"
+#include "zomefab/pieces/pieces.h"
+#include "zomefab/zome/structure.h"
+
+namespace zomefab::pieces::detail {
+
+/// Tenons (paper §6.1) and engraved numbers of every piece of @p out, against the shell @p shell
+/// and the voxel owners of @p field. Warnings for pieces short of tenons or numbers.
+void planPieces(Pieces& out, const VoxelField& field, const FloatGrid& shell, const zome::Structure& frame,
+                const Transform4d& frameToGridMm, const PiecesOptions& options, const RunContext& context);
+
+/// For every piece, the leaves that hold its inside voxels and their 26 neighbours (the band is
+/// three voxels wide).
+std::vector<std::vector<uint32_t>> leavesOfPieces(const VoxelField& field, size_t pieceCount);
+
+/// One piece's level set ψ_P = max(φ_shell, δ_P) ∪ tenons − number, and where the mesher keeps
+/// full resolution (around tenons and numbers; null when there are none).
+struct PieceGrid {
+    FloatGrid::Ptr grid;
+    openvdb::BoolTree::Ptr fullResolution;
+};
+PieceGrid pieceGrid(const VoxelField& field, const GridCells& cells, const CellSet& set, const Piece& piece,
+                    const std::vector<uint32_t>& leaves, const openvdb::math::Transform& transform,
+                    const PiecesOptions& options);
+
+/// Checks @p mesh (closed, outward; sealed pockets filled), measures its cut faces, turns it onto
+/// the printer's bed and stores it in @p piece. Returns the orientation's note (empty when a cut
+/// face lies on the bed). @throw Error(ProcessingFailed) naming the piece when its mesh is not
+/// closed or it fits @p printerMm in no orientation.
+std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, const CellSet& set,
+                        const Vec3d& printerMm, double voxelMm, const RunContext& context);
+
+}  // namespace zomefab::pieces::detail

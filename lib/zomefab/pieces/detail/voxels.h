@@ -1,0 +1,147 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file The pieces stage's view of the shell (internal to lib/zomefab/pieces): every voxel of its
+/// band and inside in leaf-sized slots with φ, its cell and its owner, and the partition's argmax
+/// cells mapped into the shell grid's millimetres. docs/pieces.md, "Cutting the shell".
+#pragma once
+
+#include <openvdb/openvdb.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "zomefab/core/transform.h"
+#include "zomefab/core/vec.h"
+#include "zomefab/partition/linear_cells.h"
+
+namespace zomefab::pieces::detail {
+
+using openvdb::Coord;
+using FloatGrid = openvdb::FloatGrid;
+using FloatTree = openvdb::FloatTree;
+using FloatLeaf = FloatTree::LeafNodeType;
+
+constexpr uint32_t kNone = 0xFFFFFFFFu;
+constexpr uint32_t kLeafSize = 512;  // 8³ voxels per leaf node
+
+/// The argmax cells mapped to grid mm, with 1/|w_i − w_j| for the plane distances.
+struct GridCells {
+    std::vector<Vec3d> w;
+    std::vector<double> b;
+    std::vector<double> invNorm;  ///< K × K; 0 for identical normals (no plane between them)
+    size_t count() const { return w.size(); }
+    double score(size_t k, const Vec3d& x) const { return dot(w[k], x) + b[k]; }
+    /// argmax_k, ties to the lowest k; fills @p scores (size K).
+    uint32_t owner(const Vec3d& x, double* scores) const {
+        uint32_t best = 0;
+        for (size_t k = 0; k < w.size(); ++k) {
+            scores[k] = score(k, x);
+            if (scores[k] > scores[best]) best = uint32_t(k);
+        }
+        return best;
+    }
+};
+
+/// The partition's cells (frame mm) in the grid's mm: s(x_f) = w·x_f + b with x_f = Rᵀ(x_g − t).
+GridCells toGridCells(const partition::LinearCells& model, const Transform4d& frameToGrid);
+
+/// The cells a piece is cut from. A cell is "shared" when its part of the shell went to several
+/// pieces (a merged sliver, or a cell the partition split): its planes then count as cuts too.
+struct CellSet {
+    std::vector<uint8_t> isMember;  ///< per cell
+    std::vector<uint32_t> members;  ///< cells of the piece
+    std::vector<uint32_t> cutters;  ///< cells whose planes may bound it: non-members and shared members
+};
+
+/// δ_P: a signed distance to the piece's region (negative inside). @p isMember says whether the
+/// voxel belongs to the piece (its owner). Near a cut face it is the exact distance to the face's
+/// plane (s_own − s_j)/|w_own − w_j|; farther away a lower bound with the right sign, which is all
+/// the mesher needs. Two pieces sharing a face see the same plane, so their faces coincide.
+/// @p scores: scratch of size K.
+double regionDistance(const GridCells& c, const CellSet& set, const Vec3d& x, bool isMember, double* scores);
+
+/// A leaf's key in VoxelField::leafIndex.
+inline uint64_t leafKey(const Coord& origin) {
+    const uint64_t bias = uint64_t(1) << 20;
+    return ((uint64_t(int64_t(origin.x() >> 3) + int64_t(bias)) & 0x1FFFFF) << 42) |
+           ((uint64_t(int64_t(origin.y() >> 3) + int64_t(bias)) & 0x1FFFFF) << 21) |
+           (uint64_t(int64_t(origin.z() >> 3) + int64_t(bias)) & 0x1FFFFF);
+}
+
+/// Every voxel of the shell's band and inside, in leaf-sized slots (leaf index × 512 + offset).
+struct VoxelField {
+    double voxelMm = 1.0;
+    Vec3d originMm{0, 0, 0};  ///< world position of index (0, 0, 0)
+    float background = 3.0f;
+    std::vector<Coord> leafOrigin;
+    std::unordered_map<uint64_t, uint32_t> leafIndex;
+    std::vector<std::array<uint32_t, 3>> nextLeaf;  ///< the +x, +y, +z neighbour leaves
+    std::vector<uint8_t> isActive;                  ///< per slot: in the band or inside
+    std::vector<float> phi;                         ///< per slot: φ_shell, clamped to ± background
+    std::vector<uint32_t> cell;                     ///< per slot: the cell it lies in (argmax)
+    /// per slot: the component of an inside voxel; after the pieces are known, the piece that owns
+    /// the voxel (inside: its piece; band: that of the nearest inside voxel of its cell); kNone
+    std::vector<uint32_t> owner;
+
+    bool isInside(size_t slot) const { return isActive[slot] && phi[slot] < 0; }
+    Coord coordOf(size_t slot) const {
+        const Coord& o = leafOrigin[slot / kLeafSize];
+        const uint32_t off = uint32_t(slot % kLeafSize);
+        return Coord(o.x() + int(off >> 6), o.y() + int((off >> 3) & 7), o.z() + int(off & 7));
+    }
+    Vec3d world(const Coord& ijk) const {
+        return {originMm[0] + voxelMm * ijk.x(), originMm[1] + voxelMm * ijk.y(),
+                originMm[2] + voxelMm * ijk.z()};
+    }
+    uint32_t leafAt(const Coord& origin) const {
+        const auto it = leafIndex.find(leafKey(origin));
+        return it == leafIndex.end() ? kNone : it->second;
+    }
+    /// The slot of the voxel nearest to @p p, or SIZE_MAX outside the field.
+    size_t slotAt(const Vec3d& p) const {
+        Coord ijk;
+        for (int a = 0; a < 3; ++a) ijk[a] = int(std::lround((p[size_t(a)] - originMm[size_t(a)]) / voxelMm));
+        const uint32_t leaf = leafAt(ijk & ~7);
+        if (leaf == kNone) return SIZE_MAX;
+        const size_t slot = size_t(leaf) * kLeafSize + FloatLeaf::coordToOffset(ijk);
+        return isActive[slot] ? slot : SIZE_MAX;
+    }
+};
+
+/// Every voxel of @p shell's band and of its whole inside (tiles voxelised), with φ clamped to
+/// the background. @throw Error(InvalidInput) for a grid that is not a uniform scale and
+/// translation; Error(Usage) for more leaves than 32-bit slot ids allow.
+VoxelField buildField(const FloatGrid& shell);
+
+/// Sets every active slot's cell (argmax of @p cells, ties to the lowest). Parallel, deterministic.
+void labelCells(VoxelField& field, const GridCells& cells);
+
+/// Calls @p visit(slot, neighbourSlot) for the +x, +y, +z neighbour of every active slot.
+template <class Visit>
+void forEachForwardPair(const VoxelField& f, Visit&& visit) {
+    const size_t n = f.leafOrigin.size();
+    for (size_t leaf = 0; leaf < n; ++leaf) {
+        for (uint32_t off = 0; off < kLeafSize; ++off) {
+            const size_t s = leaf * kLeafSize + off;
+            if (!f.isActive[s]) continue;
+            const uint32_t x = off >> 6, y = (off >> 3) & 7, z = off & 7;
+            const uint32_t nx = f.nextLeaf[leaf][0], ny = f.nextLeaf[leaf][1], nz = f.nextLeaf[leaf][2];
+            if (x < 7)
+                visit(s, s + 64);
+            else if (nx != kNone)
+                visit(s, size_t(nx) * kLeafSize + off - 448);
+            if (y < 7)
+                visit(s, s + 8);
+            else if (ny != kNone)
+                visit(s, size_t(ny) * kLeafSize + off - 56);
+            if (z < 7)
+                visit(s, s + 1);
+            else if (nz != kNone)
+                visit(s, size_t(nz) * kLeafSize + off - 7);
+        }
+    }
+}
+
+}  // namespace zomefab::pieces::detail

@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// A piece's mesh checked and turned for the printer (detail/stages.h, docs/pieces.md §4–5).
+#include <algorithm>
+
+#include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
+#include "zomefab/mesh/mesh_check.h"
+#include "zomefab/pieces/detail/stages.h"
+#include "zomefab/pieces/orientation.h"
+
+namespace zomefab::pieces::detail {
+
+namespace {
+
+/// The planes between the piece's cells and the others, outward into the other cell.
+std::vector<CutFace> cutPlanes(const GridCells& cells, const CellSet& set) {
+    const size_t cellCount = cells.count();
+    std::vector<CutFace> planes;
+    for (uint32_t k : set.members)
+        for (uint32_t j = 0; j < cellCount; ++j) {
+            if (set.isMember[j]) continue;
+            const double inv = cells.invNorm[k * cellCount + j];
+            if (inv <= 0) continue;
+            planes.push_back({scale(sub(cells.w[j], cells.w[k]), inv), (cells.b[j] - cells.b[k]) * inv, 0.0});
+        }
+    return planes;
+}
+
+[[noreturn]] void failFit(const Piece& piece, const PrintOrientation& orientation, const Vec3d& printerMm) {
+    const Vec3d e = orientation.extentsMm;
+    throw Error(ErrorCode::ProcessingFailed,
+                "piece " + std::to_string(piece.id) + " (" + formatNumber(e[0], 4) + " × " +
+                    formatNumber(e[1], 4) + " × " + formatNumber(e[2], 4) + " mm at best) fits the " +
+                    formatNumber(printerMm[0], 4) + " × " + formatNumber(printerMm[1], 4) + " × " +
+                    formatNumber(printerMm[2], 4) +
+                    " mm printer in no orientation: the partition must cut it smaller (zf-partition "
+                    "--printer-mm, --fit-margin-mm)");
+}
+
+}  // namespace
+
+std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, const CellSet& set,
+                        const Vec3d& printerMm, double voxel, const RunContext& context) {
+    // Sealed pockets of a few voxels (seen up to 28 voxels, where a tenon prism meets a tilted
+    // wall) would be printed as empty pockets and make admesh count extra parts: fill them. An
+    // uncut closed shell keeps its hollow, which is far larger.
+    const mesh::CavityRemoval cavities = mesh::removeCavities(mesh, 1000.0 * voxel * voxel * voxel);
+    if (cavities.cavities > 0)
+        context.debug("piece " + std::to_string(piece.id) + ": filled " + std::to_string(cavities.cavities) +
+                      " sealed cavities of " + formatNumber(cavities.volumeMm3, 4) + " mm³");
+    const mesh::MeshReport report = mesh::checkMesh(mesh);
+    if (report.boundaryEdges > 0 || report.nonManifoldEdges > 0 || !(report.volume > 0))
+        throw Error(ErrorCode::ProcessingFailed,
+                    "piece " + std::to_string(piece.id) + ": the mesh is not a closed, outward surface (" +
+                        std::to_string(report.boundaryEdges) + " boundary and " +
+                        std::to_string(report.nonManifoldEdges) + " non-manifold edges, volume " +
+                        formatNumber(report.volume, 4) + " mm³)");
+    piece.volumeMm3 = report.volume;
+    piece.gridBoundsMm = boundingBox(mesh);
+    const std::vector<CutFace> faces = measureCutFaces(mesh, cutPlanes(cells, set), 0.05 * voxel);
+    const PrintOrientation orientation = orientForPrinter(mesh, faces, printerMm);
+    if (!orientation.fits) failFit(piece, orientation, printerMm);
+    piece.gridToPrintMm = orientation.transformMm;
+    piece.isCutFaceDown = orientation.isCutFaceDown;
+    piece.downNormalGridMm = orientation.downNormal;
+    piece.baseAreaMm2 = orientation.baseAreaMm2;
+    piece.extentsMm = orientation.extentsMm;
+    transformInPlace(mesh, orientation.transformMm);
+    // The adaptive mesher can emit two points a float's rounding apart (seen where a tenon off the
+    // lattice axes meets a curved wall); turned onto the bed they can round to the same point.
+    // Welded, the zero-area triangles between them repeat a vertex and go, so the STL has no
+    // degenerate facet.
+    weldIdenticalVertices(mesh);
+    mesh.triangles.erase(std::remove_if(mesh.triangles.begin(), mesh.triangles.end(), hasRepeatedIndex),
+                         mesh.triangles.end());
+    piece.mesh = std::move(mesh);
+    return orientation.note;
+}
+
+}  // namespace zomefab::pieces::detail

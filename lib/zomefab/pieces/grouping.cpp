@@ -1,0 +1,344 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// From the shell's voxels to pieces (detail/grouping.h, docs/pieces.md §1).
+#include "zomefab/pieces/detail/grouping.h"
+
+#include <algorithm>
+
+#include "zomefab/core/disjoint_sets.h"
+#include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
+#include "zomefab/sdf/level_set.h"
+
+namespace zomefab::pieces::detail {
+
+namespace {
+
+using Contacts = std::map<std::pair<uint32_t, uint32_t>, size_t>;
+
+/// Components of one group that touch form one piece. Then two kinds of pieces join the
+/// neighbour they share the largest cut face with: the parts of the shell in cells that no
+/// request names (cells with no outer surface: the partition meant no piece there), whatever
+/// their size, and slivers below minPieceVolumeMm3. Never dropped: with no neighbour they stay.
+struct Merger {
+    const Contacts& contacts;
+    DisjointSets sets;
+    std::vector<double> rootVolume;
+    std::vector<uint32_t> rootSlivers;
+    std::vector<uint8_t> isOrphan;  ///< per root: only components of unnamed cells
+
+    Merger(const std::vector<Component>& comps, const Contacts& c, size_t requestCount, double voxelVolume)
+        : contacts(c),
+          sets(comps.size()),
+          rootVolume(comps.size(), 0.0),
+          rootSlivers(comps.size(), 0),
+          isOrphan(comps.size(), 0) {
+        for (const auto& [pair, count] : contacts)
+            if (comps[pair.first].group == comps[pair.second].group) sets.unite(pair.first, pair.second);
+        for (size_t k = 0; k < comps.size(); ++k) {
+            rootVolume[sets.find(uint32_t(k))] += double(comps[k].voxels) * voxelVolume;
+            isOrphan[k] = comps[k].group >= requestCount;
+        }
+    }
+
+    /// Merges @p root into the neighbour with the largest contact (named pieces before unnamed
+    /// ones, ties to the lowest root). False when it touches no other piece.
+    bool mergeIntoNeighbour(uint32_t root, bool isOrphanPass) {
+        std::map<uint32_t, size_t> shared;  // neighbour root → contact voxel faces
+        for (const auto& [pair, count] : contacts) {
+            const uint32_t ra = sets.find(pair.first), rb = sets.find(pair.second);
+            if (ra == rb) continue;
+            if (ra == root)
+                shared[rb] += count;
+            else if (rb == root)
+                shared[ra] += count;
+        }
+        if (shared.empty()) return false;
+        uint32_t target = kNone;
+        for (const auto& [r, count] : shared) {
+            if (target == kNone) {
+                target = r;
+                continue;
+            }
+            const bool isBetterKind = isOrphan[target] && !isOrphan[r];
+            const bool isSameKind = isOrphan[target] == isOrphan[r];
+            if (isBetterKind || (isSameKind && count > shared[target])) target = r;
+        }
+        const double volume = rootVolume[root] + rootVolume[target];
+        const uint32_t slivers = rootSlivers[root] + rootSlivers[target] + (isOrphanPass ? 0 : 1);
+        const bool isStillOrphan = isOrphan[root] && isOrphan[target];
+        sets.unite(root, target);
+        const uint32_t merged = sets.find(root);
+        rootVolume[merged] = volume;
+        rootSlivers[merged] = slivers;
+        isOrphan[merged] = isStillOrphan;
+        return true;
+    }
+
+    std::vector<uint32_t> rootsByVolume() {
+        std::vector<uint32_t> roots;
+        for (size_t k = 0; k < rootVolume.size(); ++k)
+            if (sets.find(uint32_t(k)) == k) roots.push_back(uint32_t(k));
+        std::stable_sort(roots.begin(), roots.end(),
+                         [&](uint32_t a, uint32_t b) { return rootVolume[a] < rootVolume[b]; });
+        return roots;
+    }
+
+    /// Orphans first (until none can move), then slivers. Returns the orphans kept.
+    size_t mergeAll(double minPieceVolumeMm3, Grouping& out, const RunContext& context) {
+        size_t orphansKept = 0;
+        for (bool isChanged = true; isChanged;) {
+            isChanged = false;
+            orphansKept = 0;
+            for (uint32_t r0 : rootsByVolume()) {
+                const uint32_t root = sets.find(r0);
+                if (root != r0 || !isOrphan[root]) continue;
+                if (mergeIntoNeighbour(root, true))
+                    isChanged = true;
+                else
+                    ++orphansKept;
+            }
+        }
+        if (out.outsideCellsVolumeMm3 > 0)
+            context.warn(
+                formatNumber(out.outsideCellsVolumeMm3, 4) +
+                " mm³ of the shell lie in cells that no partition piece names; merged into their neighbours" +
+                (orphansKept ? " (" + std::to_string(orphansKept) + " with no neighbour kept as pieces)"
+                             : ""));
+        for (uint32_t r0 : rootsByVolume()) {
+            const uint32_t root = sets.find(r0);
+            if (rootVolume[root] >= minPieceVolumeMm3) continue;
+            if (mergeIntoNeighbour(root, false)) {
+                ++out.sliversMerged;
+            } else {
+                ++out.isolatedSlivers;
+                context.warn("a " + formatNumber(rootVolume[root], 4) +
+                             " mm³ piece touches no other piece and cannot be merged: it is kept as it is");
+            }
+        }
+        return orphansKept;
+    }
+};
+
+/// Piece ids: roots ordered by the lowest group they hold (then by their first voxel).
+std::vector<uint32_t> orderPieces(const std::vector<Component>& comps, DisjointSets& sets,
+                                  std::vector<uint32_t>& roots) {
+    std::map<uint32_t, uint32_t> lowestGroup;
+    for (size_t k = 0; k < comps.size(); ++k) {
+        const uint32_t r = sets.find(uint32_t(k));
+        auto it = lowestGroup.find(r);
+        if (it == lowestGroup.end())
+            lowestGroup[r] = comps[k].group;
+        else
+            it->second = std::min(it->second, comps[k].group);
+    }
+    roots.clear();
+    for (const auto& [r, g] : lowestGroup) roots.push_back(r);
+    std::stable_sort(roots.begin(), roots.end(),
+                     [&](uint32_t a, uint32_t b) { return lowestGroup[a] < lowestGroup[b]; });
+    std::vector<uint32_t> idOfRoot(comps.size(), kNone), pieceOfComp(comps.size(), kNone);
+    for (size_t i = 0; i < roots.size(); ++i) idOfRoot[roots[i]] = uint32_t(i);
+    for (size_t k = 0; k < comps.size(); ++k) pieceOfComp[k] = idOfRoot[sets.find(uint32_t(k))];
+    return pieceOfComp;
+}
+
+/// Voxel owners: inside voxels belong to their piece; band voxels outside the shell to the piece
+/// of the nearest inside voxel of the same cell (up to the band's width, by layers, the lowest
+/// piece id on ties), else to the piece holding most of their cell. Returns the number of pieces
+/// per cell (a cell of several pieces is "shared").
+std::vector<uint32_t> ownVoxels(VoxelField& field, const std::vector<Component>& comps,
+                                const std::vector<uint32_t>& pieceOfComp, size_t cellCount) {
+    std::vector<uint32_t> cellPieceCount(cellCount, 0), cellDefault(cellCount, kNone);
+    {
+        std::vector<size_t> best(cellCount, 0);
+        std::vector<std::vector<uint32_t>> piecesOfCell(cellCount);
+        for (size_t c = 0; c < comps.size(); ++c) {
+            const uint32_t k = comps[c].cell, p = pieceOfComp[c];
+            if (std::find(piecesOfCell[k].begin(), piecesOfCell[k].end(), p) == piecesOfCell[k].end())
+                piecesOfCell[k].push_back(p);
+            if (cellDefault[k] == kNone || comps[c].voxels > best[k])
+                cellDefault[k] = p, best[k] = comps[c].voxels;
+        }
+        for (size_t k = 0; k < cellCount; ++k) cellPieceCount[k] = uint32_t(piecesOfCell[k].size());
+    }
+    const size_t slotCount = field.phi.size();
+    for (size_t s = 0; s < slotCount; ++s)
+        if (field.isInside(s)) field.owner[s] = pieceOfComp[field.owner[s]];
+    std::vector<uint32_t> proposal(slotCount, kNone);
+    std::vector<size_t> touched;
+    for (int layer = 0; layer < sdf::kHalfWidthVoxels; ++layer) {
+        auto offer = [&](size_t from, size_t to) {
+            if (!field.isActive[to] || field.owner[from] == kNone || field.owner[to] != kNone ||
+                field.cell[from] != field.cell[to])
+                return;
+            if (proposal[to] == kNone) touched.push_back(to);
+            proposal[to] = std::min(proposal[to], field.owner[from]);
+        };
+        forEachForwardPair(field, [&](size_t a, size_t b) {
+            offer(a, b);
+            offer(b, a);
+        });
+        for (size_t slot : touched) field.owner[slot] = proposal[slot], proposal[slot] = kNone;
+        touched.clear();
+    }
+    for (size_t s = 0; s < slotCount; ++s)
+        if (field.isActive[s] && field.owner[s] == kNone) field.owner[s] = cellDefault[field.cell[s]];
+    return cellPieceCount;
+}
+
+/// The pieces' cells, requests and volumes, their cell sets, and who shares a cut face with whom.
+void describePieces(Grouping& out, const std::vector<Component>& comps,
+                    const std::vector<uint32_t>& pieceOfComp, const std::vector<uint32_t>& cellPieceCount,
+                    const Contacts& contacts, size_t requestCount, double voxelMm) {
+    const double voxelVolume = voxelMm * voxelMm * voxelMm;
+    const size_t cellCount = cellPieceCount.size();
+    for (size_t c = 0; c < comps.size(); ++c) {
+        Piece& piece = out.pieces[pieceOfComp[c]];
+        piece.cells.push_back(comps[c].cell);
+        if (comps[c].group < requestCount) piece.requests.push_back(comps[c].group);
+        piece.shellVolumeMm3 += double(comps[c].voxels) * voxelVolume;
+        out.shellVolumeMm3 += double(comps[c].voxels) * voxelVolume;
+    }
+    out.cellSets.assign(out.pieces.size(), {});
+    for (size_t p = 0; p < out.pieces.size(); ++p) {
+        Piece& piece = out.pieces[p];
+        for (auto* list : {&piece.cells, &piece.requests}) {
+            std::sort(list->begin(), list->end());
+            list->erase(std::unique(list->begin(), list->end()), list->end());
+        }
+        CellSet& set = out.cellSets[p];
+        set.isMember.assign(cellCount, 0);
+        for (uint32_t c : piece.cells) set.isMember[c] = 1;
+        for (uint32_t k = 0; k < cellCount; ++k) {
+            if (set.isMember[k]) set.members.push_back(k);
+            if (!set.isMember[k] || cellPieceCount[k] > 1) set.cutters.push_back(k);
+        }
+    }
+    std::map<std::pair<uint32_t, uint32_t>, size_t> pieceContacts;
+    for (const auto& [pair, count] : contacts) {
+        const uint32_t a = pieceOfComp[pair.first], b = pieceOfComp[pair.second];
+        if (a != b) pieceContacts[{std::min(a, b), std::max(a, b)}] += count;
+    }
+    for (const auto& [pair, count] : pieceContacts) {
+        const double area = double(count) * voxelMm * voxelMm;
+        out.pieces[pair.first].neighbors.push_back({pair.second, area});
+        out.pieces[pair.second].neighbors.push_back({pair.first, area});
+    }
+    for (Piece& piece : out.pieces) std::sort(piece.neighbors.begin(), piece.neighbors.end());
+}
+
+}  // namespace
+
+std::vector<Component> findComponents(VoxelField& field) {
+    const size_t slotCount = field.phi.size();
+    DisjointSets voxelSets(slotCount);
+    forEachForwardPair(field, [&](size_t a, size_t b) {
+        if (field.isInside(a) && field.isInside(b) && field.cell[a] == field.cell[b])
+            voxelSets.unite(uint32_t(a), uint32_t(b));
+    });
+    std::vector<Component> comps;
+    field.owner.assign(slotCount, kNone);
+    std::vector<uint32_t> compOfRoot(slotCount, kNone);
+    for (size_t s = 0; s < slotCount; ++s) {
+        if (!field.isInside(s)) continue;
+        const uint32_t root = voxelSets.find(uint32_t(s));
+        if (compOfRoot[root] == kNone) {
+            compOfRoot[root] = uint32_t(comps.size());
+            comps.push_back({field.cell[s], 0, 0});
+        }
+        field.owner[s] = compOfRoot[root];
+        ++comps[compOfRoot[root]].voxels;
+    }
+    return comps;
+}
+
+std::map<std::pair<uint32_t, uint32_t>, size_t> componentContacts(const VoxelField& field) {
+    Contacts contacts;
+    forEachForwardPair(field, [&](size_t a, size_t b) {
+        if (!field.isInside(a) || !field.isInside(b)) return;
+        const uint32_t ca = field.owner[a], cb = field.owner[b];
+        if (ca != cb) ++contacts[{std::min(ca, cb), std::max(ca, cb)}];
+    });
+    return contacts;
+}
+
+double assignGroups(std::vector<Component>& comps, const VoxelField& field,
+                    const std::vector<partition::Piece>& requests, size_t cellCount,
+                    const Transform4d& gridToFrame, double grow, double voxelVolume) {
+    std::vector<std::vector<uint32_t>> cellRequests(cellCount);
+    for (size_t r = 0; r < requests.size(); ++r)
+        for (uint32_t c : requests[r].cells) cellRequests[c].push_back(uint32_t(r));
+    for (auto& list : cellRequests) {
+        std::sort(list.begin(), list.end());
+        list.erase(std::unique(list.begin(), list.end()), list.end());
+    }
+    double orphanVolume = 0.0;
+    std::vector<std::vector<size_t>> votes(comps.size());
+    bool needsVotes = false;
+    for (size_t c = 0; c < comps.size(); ++c) {
+        const auto& reqs = cellRequests[comps[c].cell];
+        if (reqs.empty()) {
+            comps[c].group = uint32_t(requests.size() + c);
+            orphanVolume += double(comps[c].voxels) * voxelVolume;
+        } else if (reqs.size() == 1) {
+            comps[c].group = reqs[0];
+        } else {
+            votes[c].assign(reqs.size(), 0);
+            needsVotes = true;
+        }
+    }
+    if (!needsVotes) return orphanVolume;
+    // A cell shared by several requests: each component goes to the request whose surface box
+    // (grown by the wall's thickness) holds most of its voxels.
+    for (size_t s = 0; s < field.phi.size(); ++s) {
+        if (!field.isInside(s) || votes[field.owner[s]].empty()) continue;
+        const uint32_t c = field.owner[s];
+        const Vec3d x = gridToFrame.apply(field.world(field.coordOf(s)));
+        const auto& reqs = cellRequests[comps[c].cell];
+        for (size_t i = 0; i < reqs.size(); ++i) {
+            const Box3d& box = requests[reqs[i]].boundsMm;
+            if (box.isEmpty()) continue;
+            bool isIn = true;
+            for (int a = 0; a < 3; ++a)
+                if (x[size_t(a)] < box.min[size_t(a)] - grow || x[size_t(a)] > box.max[size_t(a)] + grow)
+                    isIn = false;
+            if (isIn) ++votes[c][i];
+        }
+    }
+    for (size_t c = 0; c < comps.size(); ++c) {
+        if (votes[c].empty()) continue;
+        const size_t best = size_t(std::max_element(votes[c].begin(), votes[c].end()) - votes[c].begin());
+        comps[c].group = cellRequests[comps[c].cell][best];
+    }
+    return orphanVolume;
+}
+
+Grouping groupPieces(VoxelField& field, const GridCells& cells, const std::vector<partition::Piece>& requests,
+                     const Transform4d& gridToFrame, double growMm, double minPieceVolumeMm3,
+                     const RunContext& context) {
+    const double voxelVolume = field.voxelMm * field.voxelMm * field.voxelMm;
+    std::vector<Component> comps = findComponents(field);
+    if (comps.empty()) throw Error(ErrorCode::InvalidInput, "the shell has no inside");
+    const Contacts contacts = componentContacts(field);
+    context.progress("pieces", 0.15);
+    context.throwIfCancelled();
+    Grouping out;
+    out.outsideCellsVolumeMm3 =
+        assignGroups(comps, field, requests, cells.count(), gridToFrame, growMm, voxelVolume);
+    Merger merger(comps, contacts, requests.size(), voxelVolume);
+    merger.mergeAll(minPieceVolumeMm3, out, context);
+    std::vector<uint32_t> roots;
+    const std::vector<uint32_t> pieceOfComp = orderPieces(comps, merger.sets, roots);
+    out.pieces.resize(roots.size());
+    for (size_t p = 0; p < roots.size(); ++p) {
+        out.pieces[p].id = uint32_t(p);
+        out.pieces[p].sliversMerged = merger.rootSlivers[roots[p]];
+    }
+    const std::vector<uint32_t> cellPieceCount = ownVoxels(field, comps, pieceOfComp, cells.count());
+    describePieces(out, comps, pieceOfComp, cellPieceCount, contacts, requests.size(), field.voxelMm);
+    context.info(std::to_string(out.pieces.size()) + " pieces from " + std::to_string(comps.size()) +
+                 " components of " + std::to_string(cells.count()) + " cells (" +
+                 std::to_string(out.sliversMerged) + " slivers merged)");
+    return out;
+}
+
+}  // namespace zomefab::pieces::detail
