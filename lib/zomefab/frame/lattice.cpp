@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 #include "zomefab/frame/energy.h"
 #include "zomefab/frame/frame_field.h"
 #include "zomefab/frame/outermost.h"
@@ -108,8 +109,8 @@ Placement evaluate(const FrameField& ff, double rotationDeg, const Vec3d& offset
                     const size_t other = pl.index(e[0], e[1], e[2]);
                     if (!ballOk[other]) continue;
                     edgeOk[3 * id + size_t(a)] =
-                        ff.isSegmentAllowed(pos(ijk[0], ijk[1], ijk[2]), depth[id],
-                                            pos(e[0], e[1], e[2]), depth[other], limit)
+                        ff.isSegmentAllowed(pos(ijk[0], ijk[1], ijk[2]), depth[id], pos(e[0], e[1], e[2]),
+                                            depth[other], limit)
                             ? 1
                             : 0;
                 }
@@ -171,22 +172,14 @@ Placement evaluate(const FrameField& ff, double rotationDeg, const Vec3d& offset
     return pl;
 }
 
-std::string mm1(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.1f", v);
-    return buf;
-}
-
 }  // namespace
 
 LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptions& options,
                              RunContext& context) {
-    if (options.offsetSteps < 1)
-        throw Error(ErrorCode::Usage, "lattice offset steps must be at least 1");
+    if (options.offsetSteps < 1) throw Error(ErrorCode::Usage, "lattice offset steps must be at least 1");
     if (options.searchRotation && !(options.rotationStepDeg > 0))
         throw Error(ErrorCode::Usage, "lattice rotation step must be positive");
-    if (field.empty())
-        throw Error(ErrorCode::ProcessingFailed, "the interior field is empty");
+    if (field.empty()) throw Error(ErrorCode::ProcessingFailed, "the interior field is empty");
     options.scale.validate();
     context.progress("lattice", 0.0);
 
@@ -232,10 +225,12 @@ LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptio
         const double need = options.zone.dMinMm + options.scale.ballRadiusMm();
         throw Error(ErrorCode::ProcessingFailed,
                     "object too thin for one B0 cube: the thickest inner region found is about " +
-                        mm1(2.0 * std::max(0.0, deepest)) + " mm across (deepest point " +
-                        mm1(deepest) + " mm inside the surface); a cube needs its 8 balls at least " +
-                        mm1(need) + " mm inside (dMin + ball radius), a region about " +
-                        mm1(b0 + 2.0 * need) + " mm across (b0 + 2 x " + mm1(need) + " mm)");
+                        formatNumbers("%.1f", 2.0 * std::max(0.0, deepest)) + " mm across (deepest point " +
+                        formatNumbers("%.1f", deepest) +
+                        " mm inside the surface); a cube needs its 8 balls at least " +
+                        formatNumbers("%.1f", need) + " mm inside (dMin + ball radius), a region about " +
+                        formatNumbers("%.1f", b0 + 2.0 * need) + " mm across (b0 + 2 x " +
+                        formatNumbers("%.1f", need) + " mm)");
     }
 
     const FrameField& ff = fields[best / perRotation];
@@ -284,8 +279,8 @@ LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptio
             for (int k = pl.lo[2]; k < pl.lo[2] + pl.n[2]; ++k) {
                 const size_t id = pl.index(i, j, k);
                 if (isBall[id] && find(id) == keep)
-                    ballId[id] = s.addBall({b0Units * zome::Golden(i), b0Units * zome::Golden(j),
-                                            b0Units * zome::Golden(k)});
+                    ballId[id] = s.addBall(
+                        {b0Units * zome::Golden(i), b0Units * zome::Golden(j), b0Units * zome::Golden(k)});
             }
     for (size_t id = 0; id < count; ++id)
         for (int a = 0; a < 3; ++a)
@@ -294,8 +289,7 @@ LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptio
     for (int i = pl.lo[0]; i + 1 < pl.lo[0] + pl.n[0]; ++i)
         for (int j = pl.lo[1]; j + 1 < pl.lo[1] + pl.n[1]; ++j)
             for (int k = pl.lo[2]; k + 1 < pl.lo[2] + pl.n[2]; ++k)
-                if (pl.isCube[pl.index(i, j, k)] && find(pl.index(i, j, k)) == keep)
-                    ++result.keptCubes;
+                if (pl.isCube[pl.index(i, j, k)] && find(pl.index(i, j, k)) == keep) ++result.keptCubes;
     context.progress("lattice", 1.0);
     return result;
 }

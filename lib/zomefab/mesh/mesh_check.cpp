@@ -65,12 +65,6 @@ void checkIndices(const TriMesh& mesh) {
                                                          std::to_string(mesh.positions.size()) + " vertices");
 }
 
-std::string formatPoint(const Vec3d& p) {
-    char buf[96];
-    std::snprintf(buf, sizeof(buf), "(%.4g, %.4g, %.4g)", p[0], p[1], p[2]);
-    return buf;
-}
-
 /// Generalised winding number of @p triangles at @p p (Van Oosterom & Strackee solid angles):
 /// +1 inside an outward closed surface, -1 inside an inward one, 0 outside.
 double windingNumber(const TriMesh& mesh, const std::vector<uint32_t>& triangles, const Vec3d& p) {
@@ -386,13 +380,21 @@ void requireClosed(const TriMesh& mesh, const std::vector<EdgeUse>& uses, const 
                 if (onBoundary[v] && loops.find(v) == v) ++loopCount;
             fail("open mesh: " + std::to_string(boundary) + " boundary edges in " +
                  std::to_string(loopCount) + (loopCount == 1 ? " loop" : " loops") + ", between " +
-                 formatPoint(boundaryBox.min) + " and " + formatPoint(boundaryBox.max) +
+                 formatNumbers("(%.4g, %.4g, %.4g)", boundaryBox.min[0], boundaryBox.min[1],
+                               boundaryBox.min[2]) +
+                 " and " +
+                 formatNumbers("(%.4g, %.4g, %.4g)", boundaryBox.max[0], boundaryBox.max[1],
+                               boundaryBox.max[2]) +
                  "; the later stages need a closed surface");
         }
         if (nonManifold > 0)
             fail("non-manifold mesh: " + std::to_string(nonManifold) +
-                 " edges shared by three or more triangles, between " + formatPoint(nonManifoldBox.min) +
-                 " and " + formatPoint(nonManifoldBox.max));
+                 " edges shared by three or more triangles, between " +
+                 formatNumbers("(%.4g, %.4g, %.4g)", nonManifoldBox.min[0], nonManifoldBox.min[1],
+                               nonManifoldBox.min[2]) +
+                 " and " +
+                 formatNumbers("(%.4g, %.4g, %.4g)", nonManifoldBox.max[0], nonManifoldBox.max[1],
+                               nonManifoldBox.max[2]));
     }
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 #include "zomefab/report/mesh_clip.h"
 
 namespace zomefab::report {
@@ -14,12 +15,6 @@ namespace {
 
 double savedPercent(double zomefab, double baseline) {
     return baseline > 0.0 ? 100.0 * (1.0 - zomefab / baseline) : 0.0;
-}
-
-std::string fixed(double v, int decimals = 2) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-    return buf;
 }
 
 nlohmann::json printJson(const PrintEstimate& e) {
@@ -96,7 +91,7 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<const TriMesh*>
         for (size_t i = 0; i < meshes.size(); ++i) {
             context.throwIfCancelled();
             const std::string label =
-                what + " " + std::to_string(i) + " at " + fixed(settings.infillPercent, 0) + "%";
+                what + " " + std::to_string(i) + " at " + formatNumbers("%.0f", settings.infillPercent) + "%";
             if (options.source == EstimateSource::PrusaSlicer) {
                 try {
                     sum += sliceWithPrusaSlicer(*meshes[i], settings, label, options.slicer, context);
@@ -179,24 +174,29 @@ std::string costReportMarkdown(const CostReport& r) {
         "Zometool (USD) | overall (USD) | time saved | material saved |\n"
         "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const CostCase& c : r.cases) {
-        const std::string label = c.name + " (" + fixed(c.infillPercent, 0) + "%)";
-        md += "| " + label + " | ZomeFab | " + fixed(c.zomefab.print.hours()) + " | " +
-              fixed(c.zomefab.assemblyHours) + " | " + fixed(c.zomefab.totalHours()) + " | " +
-              fixed(c.zomefab.filament.costUsd) + " | " + fixed(c.zomefab.zomeUsd) + " | " +
-              fixed(c.zomefab.totalUsd()) + " | " + fixed(c.savedTimePercent) + "% | " +
-              fixed(c.savedMaterialPercent) + "% |\n";
+        const std::string label = c.name + " (" + formatNumbers("%.0f", c.infillPercent) + "%)";
+        md += "| " + label + " | ZomeFab | " + formatNumbers("%.2f", c.zomefab.print.hours()) + " | " +
+              formatNumbers("%.2f", c.zomefab.assemblyHours) + " | " +
+              formatNumbers("%.2f", c.zomefab.totalHours()) + " | " +
+              formatNumbers("%.2f", c.zomefab.filament.costUsd) + " | " +
+              formatNumbers("%.2f", c.zomefab.zomeUsd) + " | " + formatNumbers("%.2f", c.zomefab.totalUsd()) +
+              " | " + formatNumbers("%.2f", c.savedTimePercent) + "% | " +
+              formatNumbers("%.2f", c.savedMaterialPercent) + "% |\n";
         md += "| | baseline (" + std::to_string(c.baseline.print.parts) + " octree parts) | " +
-              fixed(c.baseline.print.hours()) + " | | " + fixed(c.baseline.totalHours()) + " | " +
-              fixed(c.baseline.filament.costUsd) + " | | " + fixed(c.baseline.totalUsd()) + " | | |\n";
+              formatNumbers("%.2f", c.baseline.print.hours()) + " | | " +
+              formatNumbers("%.2f", c.baseline.totalHours()) + " | " +
+              formatNumbers("%.2f", c.baseline.filament.costUsd) + " | | " +
+              formatNumbers("%.2f", c.baseline.totalUsd()) + " | | |\n";
     }
-    md += "\nFilament (" + fixed(r.options.filament.diameterMm) + " mm, " +
-          fixed(r.options.filament.usdPerM) + " USD/m): ";
+    md += "\nFilament (" + formatNumbers("%.2f", r.options.filament.diameterMm) + " mm, " +
+          formatNumbers("%.2f", r.options.filament.usdPerM) + " USD/m): ";
     for (size_t i = 0; i < r.cases.size(); ++i) {
         const CostCase& c = r.cases[i];
-        md += (i ? "; " : "") + c.name + " ZomeFab " + fixed(c.zomefab.filament.lengthM, 1) + " m / " +
-              fixed(c.zomefab.filament.massG, 0) + " g, baseline " + fixed(c.baseline.filament.lengthM, 1) +
-              " m / " + fixed(c.baseline.filament.massG, 0) + " g (" + fixed(c.savedFilamentPercent, 1) +
-              "% less plastic)";
+        md += (i ? "; " : "") + c.name + " ZomeFab " + formatNumbers("%.1f", c.zomefab.filament.lengthM) +
+              " m / " + formatNumbers("%.0f", c.zomefab.filament.massG) + " g, baseline " +
+              formatNumbers("%.1f", c.baseline.filament.lengthM) + " m / " +
+              formatNumbers("%.0f", c.baseline.filament.massG) + " g (" +
+              formatNumbers("%.1f", c.savedFilamentPercent) + "% less plastic)";
     }
     md += ". Times and filament from the " + std::string(estimateSourceName(r.source)) + ".\n";
     return md;

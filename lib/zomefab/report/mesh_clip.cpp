@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 
 namespace zomefab::report {
 
@@ -161,9 +162,8 @@ void capCut(TriMesh& out, const std::vector<std::pair<uint32_t, uint32_t>>& capE
     std::vector<uint32_t> nextOf(cutCount, UINT32_MAX);
     std::vector<uint32_t> incoming(cutCount, 0);
     auto openCut = [&](const char* why) {
-        char at[64];
-        std::snprintf(at, sizeof at, " (cut at %c = %.4f mm)", "xyz"[axis], c);
-        throw Error(ErrorCode::InvalidInput, std::string("mesh is not closed: ") + why + at);
+        throw Error(ErrorCode::InvalidInput, std::string("mesh is not closed: ") + why + " (cut at " +
+                                                 "xyz"[axis] + formatNumbers(" = %.4f mm)", c));
     };
     for (const auto& [from, to] : capEdges) {
         if (nextOf[from - firstCut] != UINT32_MAX) openCut("a cut edge is shared by more than two triangles");

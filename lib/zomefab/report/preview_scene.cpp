@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 #include "zomefab/core/vec.h"
 #include "zomefab/core/version.h"
 #include "zomefab/zome/parts.h"
@@ -146,12 +147,6 @@ GlbMesh prismMesh(const std::string& name, const std::vector<std::array<double, 
     return mesh;
 }
 
-std::string pad2(size_t i) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%02zu", i);
-    return buf;
-}
-
 }  // namespace
 
 std::vector<std::array<double, 2>> strutCrossSection(zome::Color color) {
@@ -211,7 +206,8 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
     if (!input.pieces.empty()) {
         const int group = addGroup("pieces");
         for (size_t i = 0; i < input.pieces.size(); ++i) {
-            const std::string name = input.pieceNames.empty() ? "piece-" + pad2(i) : input.pieceNames[i];
+            const std::string name = input.pieceNames.empty() ? "piece-" + formatNumbers("%02.0f", double(i))
+                                                              : input.pieceNames[i];
             if (!input.pieces[i] || input.pieces[i]->triangles.empty())
                 throw Error(ErrorCode::Usage, "preview: " + name + " is empty");
             scene.materials.push_back(pieceMaterial(i, name));

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <string>
 
+#include "zomefab/core/format.h"
+
 namespace zomefab::zome {
 
 size_t PartsList::strutTotal() const {
@@ -63,11 +65,9 @@ std::string partsTable(const PartsList& parts, const PriceOptions& prices) {
         for (int size = 0; size < kSizeCount; ++size)
             out += pad(std::to_string(parts.count(c, size)), width + (size == kSizeCount - 1 ? 1 : 0));
     out += pad(std::to_string(parts.strutTotal()), totalWidth) + std::to_string(parts.balls) + "\n";
-    char cost[160];
-    std::snprintf(cost, sizeof cost, "\nCost: %zu struts x %.2f USD + %zu balls x %.2f USD = %.2f USD\n",
-                  parts.strutTotal(), prices.strutUsd, parts.balls, prices.ballUsd,
-                  partsCostUsd(parts, prices));
-    return out + cost;
+    return out + "\nCost: " + std::to_string(parts.strutTotal()) +
+           formatNumbers(" struts x %.2f USD + ", prices.strutUsd) + std::to_string(parts.balls) +
+           formatNumbers(" balls x %.2f USD = %.2f USD\n", prices.ballUsd, partsCostUsd(parts, prices));
 }
 
 }  // namespace zomefab::zome
