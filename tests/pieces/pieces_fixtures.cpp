@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "test_util.h"
+#include "zomefab/core/json_values.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/core/vec.h"
@@ -148,9 +149,7 @@ void writeToolInputs(const std::string& dir) {
         nlohmann::json j;
         j["format"] = "zomefab.partition";
         j["version"] = 1;
-        nlohmann::json rows = nlohmann::json::array();
-        for (int r = 0; r < 4; ++r) rows.push_back({t.at(r, 0), t.at(r, 1), t.at(r, 2), t.at(r, 3)});
-        j["transform_mm"] = rows;
+        j["transform_mm"] = toJson(t);
         j["printer_mm"] = {200, 200, 200};
         for (size_t k = 0; k < cells.cellCount(); ++k) {
             j["cells"].push_back({{"cell", k}, {"w", cells.w[k]}, {"b", cells.b[k]}});

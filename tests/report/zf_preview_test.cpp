@@ -14,6 +14,7 @@
 #include "glb_test_util.h"
 #include "report_fixtures.h"
 #include "test_util.h"
+#include "zomefab/core/json_values.h"
 #include "zomefab/core/transform.h"
 #include "zomefab/io/file_io.h"
 #include "zomefab/io/mesh_io.h"
@@ -85,11 +86,7 @@ TEST_CASE("zf-preview: pieces.json pieces go back from the printer to the frame'
     TriMesh printed = makeBox({10, 0, 0}, {30, 20, 5});
     transformInPlace(printed, gridToPrint * frameToGrid);
     writeMesh(printed, dir.file("piece-00.stl"));
-    auto matrix = [](const Transform4d& t) {
-        nlohmann::json rows = nlohmann::json::array();
-        for (int r = 0; r < 4; ++r) rows.push_back({t.at(r, 0), t.at(r, 1), t.at(r, 2), t.at(r, 3)});
-        return rows;
-    };
+    auto matrix = [](const Transform4d& t) { return toJson(t); };
     const nlohmann::json pieces = {{"format", "zomefab.pieces"},
                                    {"version", 1},
                                    {"frame_to_grid_mm", matrix(frameToGrid)},
