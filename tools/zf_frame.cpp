@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
     app.add_option("object", input, "OBJECT.vdb from zf-sdf (- reads stdin)")->required();
     app.add_option("-o,--output", output, "Output frame file FRAME.json (- writes stdout)")->required();
     app.add_option("--grid", gridName, "Level set to read")->capture_default_str();
-    fabricationCli.addTo(app, cli::kFrameClearance);
+    fabricationCli.addTo(app, cli::kFrameClearance | cli::kWall);
     frameCli.addTo(app);
 
     return tool.run(argc, argv, [&](nlohmann::json& report) {

@@ -48,8 +48,10 @@ pieces::Pieces cut(const sdf::LevelSet& shell, const zome::Structure& frame, con
 int main(int argc, char** argv) {
     cli::Tool tool(
         "zf-pieces",
-        "Cut the shell into printable pieces along the partition's cells, grow tenons into the frame's "
-        "free blue holes, engrave piece numbers, orient each piece for the printer (paper §6).");
+        "Cut the shell into printable pieces along the partition's cells, plan how each goes onto the frame "
+        "(one Zome direction per piece, an order), grow its tenons into the frame's holes along that "
+        "direction, "
+        "engrave piece numbers, orient each piece for the printer (paper §6, docs/mounting.md).");
     std::string shellPath, framePath, partitionPath, output, gridName;
     cli::FabricationCli fabricationCli;
     cli::PiecesCli piecesCli;
@@ -88,6 +90,7 @@ int main(int argc, char** argv) {
         }();
         const pieces::Pieces result = cut(shell, frame, frameToGrid, partition.result, fabrication, options,
                                           context, {shellPath, framePath, partitionPath});
+        pieces::requireBuildable(result);  // never write pieces that cannot be put on the frame
         pieces::writePieces(result, output,
                             {shell.info().sourceFile, fs::path(framePath).filename().string(),
                              fs::path(partitionPath).filename().string()});

@@ -115,30 +115,53 @@ TEST_CASE("transform: affineInverse undoes a rotation, scale and translation") {
     CHECK_THROWS_AS(affineInverse(singular), Error);
 }
 
-TEST_CASE("tenons: signed distance of the prism and the peg") {
+TEST_CASE("tenons: the prism's signed distance and the exact peg mesh") {
     TenonOptions o;
     Tenon t;
+    t.hole = 2;  // blue, +z: the section's long side along x
     t.axisGrid = {0, 0, 1};
     t.longSideGrid = {1, 0, 0};
     t.shoulderMm = 8.85;
     t.pegTipMm = 8.85 - o.pegDepthMm;
     t.baseMm = 30;
     t.endMm = 32;
-    // Peg: 5.16 (x) × 3.08 (y) mm, from z = 4.85 to the shoulder.
-    CHECK(tenonSignedDistanceMm(t, o, {0, 0, 6}) < 0);
-    CHECK(tenonSignedDistanceMm(t, o, {0.5 * pegLongMm(o) + 0.1, 0, 6}) == doctest::Approx(0.1));
-    CHECK(tenonSignedDistanceMm(t, o, {0, 0.5 * pegShortMm(o) + 0.2, 6}) == doctest::Approx(0.2));
-    CHECK(tenonSignedDistanceMm(t, o, {0, 0, t.pegTipMm - 0.3}) == doctest::Approx(0.3));
-    // Prism: 7 × 7 mm from the shoulder to z = 32.
+    // Prism: 7 × 7 mm from 0.3 mm past the shoulder to z = 32; the peg is not in it.
     CHECK(tenonSignedDistanceMm(t, o, {3.4, 3.4, 20}) < 0);
     CHECK(tenonSignedDistanceMm(t, o, {3.6, 0, 20}) == doctest::Approx(0.1));
     CHECK(tenonSignedDistanceMm(t, o, {0, 0, 32.5}) == doctest::Approx(0.5));
-    // Beside the peg, below the shoulder: outside.
-    CHECK(tenonSignedDistanceMm(t, o, {3.0, 0, 7.0}) > 0);
+    CHECK(tenonSignedDistanceMm(t, o, {0, 0, 8.85}) == doctest::Approx(0.3));
+    CHECK(tenonSignedDistanceMm(t, o, {0, 0, 6}) > 0);
     const Box3d box = tenonBoundsMm(t, o);
     CHECK(box.min[2] == doctest::Approx(t.pegTipMm));
     CHECK(box.max[2] == doctest::Approx(32));
     CHECK(box.max[0] == doctest::Approx(3.5));
+
+    // The peg: the hole's rectangle less the clearance, from the tip (4.85) 1.5 mm into the prism,
+    // closed and outward, its tip chamfered.
+    const TriMesh peg = pegMesh(t, o);
+    const Box3d pb = boundingBox(peg);
+    CHECK(pb.min[2] == doctest::Approx(t.pegTipMm).epsilon(1e-6));
+    CHECK(pb.max[2] == doctest::Approx(t.shoulderMm + 1.5).epsilon(1e-6));
+    CHECK(pb.max[0] == doctest::Approx(0.5 * pegLongMm(o)).epsilon(1e-6));
+    CHECK(pb.max[1] == doctest::Approx(0.5 * pegShortMm(o)).epsilon(1e-6));
+    const double length = t.shoulderMm + 1.5 - t.pegTipMm;
+    const double full = pegLongMm(o) * pegShortMm(o) * length;
+    CHECK(signedVolume(peg) > 0.95 * full);  // the chamfer takes a little
+    CHECK(signedVolume(peg) < full);
+    std::map<std::pair<uint32_t, uint32_t>, int> edges;  // every edge used once each way
+    for (const auto& tri : peg.triangles)
+        for (int e = 0; e < 3; ++e) ++edges[{tri[size_t(e)], tri[size_t((e + 1) % 3)]}];
+    for (const auto& [edge, count] : edges) {
+        CHECK(count == 1);
+        CHECK(edges.count({edge.second, edge.first}) == 1);
+    }
+    // Yellow and red pegs follow their holes' triangle and pentagon.
+    Tenon yellow = t;
+    yellow.hole = zome::holeRange(zome::Color::Yellow).first;
+    CHECK(pegMesh(yellow, o).positions.size() == 9);
+    Tenon red = t;
+    red.hole = zome::holeRange(zome::Color::Red).first;
+    CHECK(pegMesh(red, o).positions.size() == 15);
 }
 
 TEST_CASE("tenons: options out of range are usage errors") {
@@ -171,7 +194,7 @@ TEST_CASE("tenons: options out of range are usage errors") {
 TEST_CASE("tenons: rays from one ball in a spherical shell") {
     const zome::Structure frame = oneBall();
     TenonOptions o;
-    o.latticeHolesOnly = true;  // the paper's six
+    o.holes = TenonHoles::Lattice;  // the paper's six
     const double inner = 30.0;
     const auto candidates =
         findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0, 5.0), o);
@@ -187,10 +210,11 @@ TEST_CASE("tenons: rays from one ball in a spherical shell") {
         // Up (+z) meets piece 0, the rest piece 1 (the cut is at z = 5).
         CHECK(c.piece == (c.tenon.hole == 2 ? 0 : 1));
     }
-    // All 30 blue holes (the default): the six above plus 24 more. Each accepted one reaches the wall
+    // All 30 blue holes: the six above plus 24 more. Each accepted one reaches the wall
     // straight on, in the piece its axis meets, with the peg's long side along the hole's rectangle;
     // the others are rays whose prism the cut at z = 5 runs through.
     TenonOptions allBlue;
+    allBlue.holes = TenonHoles::Blue;
     const auto all =
         findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0, 5.0), allBlue);
     REQUIRE(all.size() == 30);
@@ -272,7 +296,7 @@ TEST_CASE("tenons: used holes, obstacles, oblique walls and cut edges are reject
         if (c.tenon.hole == 0) CHECK(c.rejection == "crosses another piece");
 }
 
-TEST_CASE("tenons: the choice gives every piece its share, prefers one direction, keeps prisms apart") {
+TEST_CASE("tenons: the choice keeps to each piece's direction, spreads the tenons, keeps prisms apart") {
     TenonOptions o;
     o.minPerPiece = 2;
     o.maxPerPiece = 3;
@@ -292,26 +316,28 @@ TEST_CASE("tenons: the choice gives every piece its share, prefers one direction
     };
     std::vector<TenonCandidate> candidates = {
         make(0, 2, {0, 0, 0}, 0, 0.9),     // A: piece 0's best, +z
-        make(1, 1, {100, 0, 0}, 0, 0.8),   // B: piece 0, +y
-        make(2, 2, {0, 100, 0}, 0, 0.5),   // C: piece 0, +z like A
-        make(3, 2, {3, 0, 0}, 1, 0.95),    // D: piece 1, 3 mm beside A: prisms would touch
-        make(4, 0, {0, -200, 0}, 1, 0.7),  // E: piece 1
+        make(1, 1, {100, 0, 0}, 0, 0.99),  // B: piece 0 but +y, not its direction
+        make(2, 2, {0, 100, 0}, 0, 0.5),   // C: piece 0, far from A
+        make(6, 2, {30, 0, 0}, 0, 0.6),    // F: piece 0, scores above C but sits near A
+        make(3, 2, {3, 0, 0}, 1, 0.95),    // D: piece 1, 3 mm beside A: the prisms would touch
+        make(4, 2, {0, -200, 0}, 1, 0.7),  // E: piece 1
     };
-    candidates.push_back(make(5, 0, {0, 300, 0}, 1, 0.99));
+    candidates.push_back(make(5, 2, {0, 300, 0}, 1, 0.99));
     candidates.back().rejection = "surface too oblique";
-    const TenonPlan plan = chooseTenons(candidates, 3, o);
+    const TenonPlan plan = chooseTenons(candidates, {2, 2, -1}, o);
     REQUIRE(plan.perPiece.size() == 3);
     REQUIRE(plan.perPiece[0].size() == 3);
     CHECK(plan.perPiece[0][0].ball == 0);
-    CHECK(plan.perPiece[0][1].ball == 2);  // parallel to the first, though B scores higher
-    CHECK(plan.perPiece[0][2].ball == 1);
+    CHECK(plan.perPiece[0][1].ball == 2);  // the spread outweighs F's better score
+    CHECK(plan.perPiece[0][2].ball == 6);
+    for (const Tenon& t : plan.perPiece[0]) CHECK(t.hole == 2);  // B never: another direction
     REQUIRE(plan.perPiece[1].size() == 1);
     CHECK(plan.perPiece[1][0].ball == 4);  // D lost to A, which was chosen first
     CHECK(plan.shortfall[0].empty());
     CHECK(plan.shortfall[1].at("another tenon in the way") == 1);
     CHECK(plan.shortfall[1].at("surface too oblique") == 1);
     CHECK(plan.perPiece[2].empty());
-    CHECK(plan.shortfall[2].count("no blue hole of a ball points at this piece") == 1);
+    CHECK(plan.shortfall[2].count("no ball's hole along the piece's direction points at it") == 1);
     // No two chosen prisms come closer than twice their radius.
     std::vector<Tenon> all;
     for (const auto& list : plan.perPiece) all.insert(all.end(), list.begin(), list.end());
@@ -326,7 +352,7 @@ TEST_CASE("tenons: the choice gives every piece its share, prefers one direction
     TenonOptions none = o;
     none.minPerPiece = 0;
     none.maxPerPiece = 0;
-    for (const auto& list : chooseTenons(candidates, 3, none).perPiece) CHECK(list.empty());
+    for (const auto& list : chooseTenons(candidates, {2, 2, -1}, none).perPiece) CHECK(list.empty());
 }
 
 TEST_CASE("tenons: a rotated frame rotates the axes and the peg") {
@@ -339,7 +365,7 @@ TEST_CASE("tenons: a rotated frame rotates the axes and the peg") {
     centred.pieceAt = [&](const Vec3d& x) { return probe.pieceAt(sub(x, {5, -3, 2})); };
     TenonOptions o;
     const auto candidates = findTenonCandidates(oneBall(), rot, centred, o);
-    CHECK(candidates.size() == 30);
+    CHECK(candidates.size() == size_t(zome::kHoleCount));  // all 62 by default
     for (const TenonCandidate& cand : candidates) {
         CHECK(cand.rejection.empty());
         const Vec3d expected = applyLinear(rot, zome::holeDirection(cand.tenon.hole));

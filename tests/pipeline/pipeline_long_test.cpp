@@ -44,6 +44,7 @@ struct DemoRun {
     report::RunRecord result;
     json report;
     std::string out;
+    bool isBuildable = false;  ///< the verifier passed (else the outputs are in out + ".failed")
 
     DemoRun() {
         options.scale.heightMm = 400;
@@ -52,7 +53,9 @@ struct DemoRun {
         result = pipeline::runPipeline(mesh, "bunny_cgal_75k.stl", options, RunContext::silent());
         report = report::runReportJson(result, RunContext::silent());
         out = dir.file("out");
-        pipeline::writeRunOutputs(result, options, report, out);
+        const pipeline::RunOutputs written =
+            pipeline::writeRunOutputs(result, options, report, out, RunContext::silent());
+        isBuildable = written.verification.passed();
     }
     std::string file(const std::string& name) const { return out + "/" + name; }
 };

@@ -24,7 +24,7 @@ pipeline::RunOptions smallRunOptions() {
     pipeline::RunOptions o;
     o.scale.heightMm = 250;
     o.scale.up = mesh::UpAxis::Y;
-    o.field.voxelMm = 1.5;  // coarse for speed, fine enough for the tenon pegs (≤ 1.54 mm)
+    o.field.voxelMm = 1.5;  // coarse for speed, fine enough for the tenon prisms (≤ 3.5 mm)
     o.frame.anneal.maxIterations = 20000;
     o.frame.chains = 2;
     o.fabrication.seed = 7;
@@ -44,7 +44,13 @@ TEST_CASE("pipeline: the small bunny end to end, outputs consistent with each ot
     test::ScratchDir dir;
     const std::string out = dir.file("run");
     const nlohmann::json report = report::runReportJson(result, RunContext::silent());
-    const auto files = pipeline::writeRunOutputs(result, options, report, out);
+    const pipeline::RunOutputs outputs =
+        pipeline::writeRunOutputs(result, options, report, out, RunContext::silent());
+    // The verifier passed on what was written, so the outputs are where they were asked for.
+    for (const std::string& line : verify::verifySummaryLines(outputs.verification)) INFO(line);
+    REQUIRE(outputs.verification.passed());
+    CHECK(outputs.directory == out);
+    const std::vector<std::string>& files = outputs.files;
     for (const std::string& f : files) CHECK(fs::exists(fs::path(out) / f));
     CHECK(files == std::vector<std::string>{"assembly.md", "cost.md", "frame.json", "frame.vef",
                                             "partition.json", "pieces.3mf", "pieces/", "preview.glb",
@@ -81,7 +87,8 @@ TEST_CASE("pipeline: same seed gives byte-identical frame and partition files") 
     for (int i = 0; i < 2; ++i) {
         const report::RunRecord r = pipeline::runPipeline(mesh, "bunny", options, RunContext::silent());
         const std::string out = dir.file("run" + std::to_string(i));
-        pipeline::writeRunOutputs(r, options, report::runReportJson(r, RunContext::silent()), out);
+        pipeline::writeRunOutputs(r, options, report::runReportJson(r, RunContext::silent()), out,
+                                  RunContext::silent());
         frames[i] = readInputBytes(out + "/frame.json");
         partitions[i] = readInputBytes(out + "/partition.json");
     }

@@ -12,6 +12,7 @@
 #include "report_test_util.h"
 #include "test_util.h"
 #include "zomefab/core/error.h"
+#include "zomefab/zome/holes.h"
 #include "zomefab/zome/parts.h"
 
 using namespace zomefab;
@@ -60,14 +61,14 @@ const GlbNode* findNode(const GlbScene& s, const std::string& name) {
 }  // namespace
 
 TEST_CASE("preview_scene: strut cross-sections have the Zome model's sizes") {
-    const auto blue = strutCrossSection(zome::Color::Blue);
+    const auto blue = zome::holeSectionMm(zome::Color::Blue);
     CHECK(blue.size() == 4);
     CHECK(polygonArea(blue) == doctest::Approx(5.46 * 3.38));
-    const auto yellow = strutCrossSection(zome::Color::Yellow);
+    const auto yellow = zome::holeSectionMm(zome::Color::Yellow);
     CHECK(yellow.size() == 3);
     const double edge = std::hypot(yellow[1][0] - yellow[0][0], yellow[1][1] - yellow[0][1]);
     CHECK(edge == doctest::Approx(5.46));  // the blue rectangle's long side
-    const auto red = strutCrossSection(zome::Color::Red);
+    const auto red = zome::holeSectionMm(zome::Color::Red);
     CHECK(red.size() == 5);
     CHECK(std::hypot(red[0][0], red[0][1]) == doctest::Approx(2.87));
     for (const auto& s : {blue, yellow, red}) CHECK(polygonArea(s) > 0.0);  // counter-clockwise

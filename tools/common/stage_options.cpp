@@ -92,6 +92,9 @@ void FabricationCli::addTo(CLI::App& app, unsigned parts) {
         app.add_option("--frame-clearance-mm", f.frameClearanceMm,
                        "Forbidden zone dMin: no ball or strut closer to the surface (mm)")
             ->capture_default_str();
+        app.add_option("--wall-gap-mm", f.wallGapMm,
+                       "Air between the inner wall and the frame: dMin is at least wall + this (mm)")
+            ->capture_default_str();
         app.add_option("--b0-mm", f.b0Mm,
                        "Length of the B0 strut, centre to centre (the kit's scale; dMax = b0)")
             ->capture_default_str();
@@ -113,9 +116,10 @@ void ValidateCli::addTo(CLI::App& app) {
 }
 
 void FieldCli::addTo(CLI::App& app) {
-    app.add_option("--voxel-mm", options.voxelMm,
-                   formatNumbers("Voxel of the object and shell level sets (at most %.2f for the tenon pegs)",
-                                 pieces::maxVoxelForPegsMm(pieces::TenonOptions{})))
+    app.add_option(
+           "--voxel-mm", options.voxelMm,
+           formatNumbers("Voxel of the object and shell level sets (at most %.2f for the tenon prisms)",
+                         pieces::maxVoxelForTenonsMm(pieces::TenonOptions{})))
         ->capture_default_str();
     app.add_option("--field-voxel-mm", options.fieldVoxelMm,
                    "Voxel size of the interior grid (frame optimisation)")
@@ -157,6 +161,14 @@ void FrameCli::addTo(CLI::App& app) {
         ->check(CLI::Range(1, 64));
     app.add_flag("--search-rotation", o.lattice.searchRotation,
                  "Also search the lattice rotation about the up axis");
+    app.add_flag(
+        "!--no-reach", o.reach.isEnabled,
+        "Keep the annealed frame as it is (the paper's): no growth toward the surface it does not reach");
+    app.add_option(
+           "--reach-min-gain", o.reach.minGainSamples,
+           "Grow the frame by a strut only where it reaches this many more surface samples (8 mm apart)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100000));
     app.add_flag(
         "--check-moves", o.checkEveryMove,
         "Debug: after every accepted move verify the frame and compare ΔE with a full recomputation (slow)");
@@ -230,9 +242,17 @@ void PiecesCli::addTo(CLI::App& app) {
     app.add_option("--tenon-max-tilt-deg", o.tenons.maxTiltDeg,
                    "Largest angle between hole axis and surface normal")
         ->capture_default_str();
-    app.add_flag(
-        "--tenon-lattice-holes-only", o.tenons.latticeHolesOnly,
-        "Tenons only along the lattice axes (+-x +-y +-z), as the paper; default: all 30 blue holes");
+    app.add_option("--tenon-holes", tenonHoles,
+                   "Directions pieces go on along and tenons use: lattice (+-x +-y +-z, as the paper), "
+                   "blue (30) or all (62: blue, yellow, red)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"lattice", "blue", "all"}));
+    app.add_option("--seam-gap-mm", o.seamGapMm, "Each cut face moved this far into its piece (glue gap)")
+        ->capture_default_str();
+    app.add_option("--mount-margin-mm", o.mount.frameMarginMm,
+                   "Balls and struts are taken this much larger when a piece's path is tested")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     app.add_flag("--no-label", isUnlabelled, "Do not engrave piece numbers");
     app.add_option("--label-height-mm", o.label.heightMm, "Height of the engraved digits")
         ->capture_default_str();
@@ -242,6 +262,7 @@ void PiecesCli::addTo(CLI::App& app) {
 pieces::PiecesOptions PiecesCli::resolve() const {
     pieces::PiecesOptions o = options;
     o.label.isEnabled = !isUnlabelled;
+    o.tenons.holes = *pieces::tenonHolesFromName(tenonHoles);
     pieces::checkPiecesOptions(o);
     return o;
 }

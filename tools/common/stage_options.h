@@ -87,6 +87,7 @@ struct PartitionCli {
 struct PiecesCli {
     pieces::PiecesOptions options;
     bool isUnlabelled = false;
+    std::string tenonHoles = "all";
 
     void addTo(CLI::App& app);
     /// @throw Error(Usage) for an option out of its range.

@@ -38,6 +38,7 @@ void checkFabrication(const Fabrication& f) {
     requireRange(f.fitMarginMm, 0.0, 100.0, "--fit-margin-mm", "mm");
     requireRange(f.wallMm, 1.0, 200.0, "--shell-mm", "mm");
     requireRange(f.frameClearanceMm, 0.0, 1000.0, "--frame-clearance-mm", "mm");
+    requireRange(f.wallGapMm, 0.0, 100.0, "--wall-gap-mm", "mm");
     requireRange(f.b0Mm, 1.0, 1000.0, "--b0-mm", "mm");
 }
 

@@ -23,6 +23,9 @@ struct Fabrication {
     /// d_min of the forbidden zone (paper §4.3.1): no ball or strut comes closer to the outer
     /// surface than this, mm.
     double frameClearanceMm = 16.0;
+    /// Air between the shell's inner wall and the frame, mm: a piece pushed onto the frame slides
+    /// past balls and struts, so the frame keeps at least wall + gap from the outer surface.
+    double wallGapMm = 3.0;
     /// Centre-to-centre length of the B0 strut, mm (paper §4.2: b0 = 47.3 measured; vZome's
     /// nominal 46.27). It sets the whole kit's scale and d_max = b0 of the forbidden zone.
     double b0Mm = 47.3;
@@ -30,8 +33,13 @@ struct Fabrication {
     /// whatever the thread count.
     uint64_t seed = 1;
 
-    /// d_max of the forbidden zone (paper §4.3.1): b0, the shortest blue strut.
-    double frameReachMm() const { return b0Mm; }
+    /// The d_min the frame is built with: the forbidden zone, or the wall and its gap where that
+    /// is deeper (a thick wall moves the frame inward).
+    double frameDMinMm() const {
+        return frameClearanceMm > wallMm + wallGapMm ? frameClearanceMm : wallMm + wallGapMm;
+    }
+    /// d_max of the forbidden zone (paper §4.3.1): b0, the shortest blue strut, past d_min.
+    double frameReachMm() const { return b0Mm > frameDMinMm() ? b0Mm : frameDMinMm() + b0Mm; }
 };
 
 /// The random streams of the stages. Each stage draws from its own stream, derived from

@@ -22,6 +22,13 @@ Vec3d Box3d::size() const {
     return {max[0] - min[0], max[1] - min[1], max[2] - min[2]};
 }
 
+void appendMesh(TriMesh& mesh, const TriMesh& other) {
+    const uint32_t base = uint32_t(mesh.positions.size());
+    mesh.positions.insert(mesh.positions.end(), other.positions.begin(), other.positions.end());
+    for (const Triangle& t : other.triangles)
+        mesh.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+}
+
 Box3d boundingBox(const TriMesh& mesh) {
     Box3d box;
     for (const Vec3f& p : mesh.positions) box.expand({p[0], p[1], p[2]});

@@ -43,6 +43,9 @@ inline bool hasRepeatedIndex(const Triangle& t) { return t[0] == t[1] || t[1] ==
 /// Bounding box of the mesh's referenced and unreferenced vertices.
 Box3d boundingBox(const TriMesh& mesh);
 
+/// Appends @p other's vertices and triangles to @p mesh (its indices shifted): one more shell.
+void appendMesh(TriMesh& mesh, const TriMesh& other);
+
 /// Merges vertices with bit-identical coordinates (−0 = +0) into one, in first-seen order, and
 /// renumbers the triangles. Triangles are kept as they are, including any that now repeat a vertex.
 void weldIdenticalVertices(TriMesh& mesh);

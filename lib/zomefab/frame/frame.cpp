@@ -161,7 +161,7 @@ std::vector<std::string> verifyFrame(const zome::Structure& s, const FrameField&
 LatticeOptions latticeOptionsFor(const Fabrication& fabrication, const LatticeOptions& options) {
     LatticeOptions o = options;
     o.scale.b0Mm = fabrication.b0Mm;
-    o.zone.dMinMm = fabrication.frameClearanceMm;
+    o.zone.dMinMm = fabrication.frameDMinMm();
     o.zone.dMaxMm = fabrication.frameReachMm();
     return o;
 }
@@ -212,8 +212,11 @@ FrameResult buildFrame(const sdf::InteriorField& field, const Fabrication& fabri
         r.chains.push_back(c.stats);
         r.chainEnergies.push_back(c.energy);
     }
-    r.finalEnergy = chains[r.bestChain].energy;
-    r.structure = chains[r.bestChain].structure.compacted();
+    r.annealedEnergy = chains[r.bestChain].energy;
+    zome::Structure grown = std::move(chains[r.bestChain].structure);
+    r.reach = growForReach(grown, ff, options.reach, context);
+    r.finalEnergy = r.reach.strutsAdded > 0 ? frameEnergy(grown, ff, r.energyOptions) : r.annealedEnergy;
+    r.structure = grown.compacted();
     r.totalSeconds = total.seconds();
     return r;
 }
@@ -274,7 +277,14 @@ nlohmann::json frameReportJson(const FrameResult& r, const FrameOptions& o, cons
               {"reachable_samples", r.target.reachableSamples},
               {"seconds", r.targetSeconds}}},
             {"energy_before", energyToJson(r.initialEnergy)},
+            {"energy_annealed", energyToJson(r.annealedEnergy)},
             {"energy_after", energyToJson(r.finalEnergy)},
+            {"reach",
+             {{"enabled", o.reach.isEnabled},
+              {"min_gain_samples", o.reach.minGainSamples},
+              {"struts_added", r.reach.strutsAdded},
+              {"coverage_before", r.reach.coverageBefore},
+              {"coverage_after", r.reach.coverageAfter}}},
             {"best_chain", r.bestChain},
             {"chains", chains},
             {"iterations", iterations},

@@ -16,6 +16,7 @@
 #include "zomefab/frame/energy.h"
 #include "zomefab/frame/frame_field.h"
 #include "zomefab/frame/lattice.h"
+#include "zomefab/frame/reach.h"
 #include "zomefab/frame/target_count.h"
 #include "zomefab/sdf/interior_field.h"
 #include "zomefab/zome/parts.h"
@@ -30,6 +31,7 @@ struct FrameOptions {
     EnergyOptions energy;       ///< weights; targetItemCount is replaced by the τ estimate
     TargetCountOptions target;  ///< how τ is estimated (or fixed)
     AnnealOptions anneal;       ///< cooling schedule and budgets
+    ReachOptions reach;         ///< growth toward the surface after annealing (reach.h)
     /// Independent annealing chains run in parallel; the best is kept. 8: on the demo bunny at 400 mm
     /// the best of 8 has E = 117.5 against 126.4 for one chain, in 0.08 s on 2 cores (32: 116.2).
     int chains = 8;
@@ -77,7 +79,9 @@ struct FrameResult {
     TargetCountResult target;        ///< τ and the runs it came from
     EnergyOptions energyOptions;     ///< with τ filled in
     EnergyTerms initialEnergy;
-    EnergyTerms finalEnergy;
+    EnergyTerms annealedEnergy;  ///< the best chain's
+    EnergyTerms finalEnergy;     ///< of the structure returned (after the reach growth)
+    ReachResult reach;
     std::vector<ChainStats> chains;
     std::vector<EnergyTerms> chainEnergies;
     size_t bestChain = 0;

@@ -27,8 +27,7 @@ std::string readInputBytes(const std::string& path) {
     std::error_code ec;
     const fs::file_status status = fs::status(path, ec);
     if (ec || !fs::exists(status)) throw Error(ErrorCode::InvalidInput, "no such file", path);
-    if (fs::is_directory(status))
-        throw Error(ErrorCode::InvalidInput, "is a directory, not a file", path);
+    if (fs::is_directory(status)) throw Error(ErrorCode::InvalidInput, "is a directory, not a file", path);
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(ErrorCode::InvalidInput, std::string("cannot open: ") + std::strerror(errno), path);
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -45,8 +44,7 @@ void writeOutputAtomic(const std::string& path, const std::function<void(std::os
     }
     const fs::path target(path);
     std::error_code ec;
-    if (fs::is_directory(target, ec))
-        throw Error(ErrorCode::WriteFailed, "is a directory, not a file", path);
+    if (fs::is_directory(target, ec)) throw Error(ErrorCode::WriteFailed, "is a directory, not a file", path);
     const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
     if (!fs::is_directory(dir, ec))
         throw Error(ErrorCode::WriteFailed, "directory does not exist: " + dir.string(), path);
@@ -54,7 +52,9 @@ void writeOutputAtomic(const std::string& path, const std::function<void(std::os
     try {
         {
             std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-            if (!out) throw Error(ErrorCode::WriteFailed, std::string("cannot create: ") + std::strerror(errno), path);
+            if (!out)
+                throw Error(ErrorCode::WriteFailed, std::string("cannot create: ") + std::strerror(errno),
+                            path);
             write(out);
             out.flush();
             if (!out) throw Error(ErrorCode::WriteFailed, "write failed (disk full?)", path);
@@ -91,6 +91,11 @@ StagedDirectory::~StagedDirectory() {
     fs::remove_all(mStaging, ec);
 }
 
+void StagedDirectory::commitAs(const std::string& target) {
+    mTarget = target;
+    commit();
+}
+
 void StagedDirectory::commit() {
     std::error_code ec;
     const fs::path target(mTarget);
@@ -102,16 +107,20 @@ void StagedDirectory::commit() {
                         mTarget);
         const fs::path old = target.string() + ".old" + std::to_string(::getpid());
         fs::rename(target, old, ec);
-        if (ec) throw Error(ErrorCode::WriteFailed, "cannot move the old output aside: " + ec.message(), mTarget);
+        if (ec)
+            throw Error(ErrorCode::WriteFailed, "cannot move the old output aside: " + ec.message(), mTarget);
         fs::rename(mStaging, target, ec);
         if (ec) {
             fs::rename(old, target);  // put the old output back
-            throw Error(ErrorCode::WriteFailed, "cannot move the output into place: " + ec.message(), mTarget);
+            throw Error(ErrorCode::WriteFailed, "cannot move the output into place: " + ec.message(),
+                        mTarget);
         }
         fs::remove_all(old, ec);
     } else {
         fs::rename(mStaging, target, ec);
-        if (ec) throw Error(ErrorCode::WriteFailed, "cannot move the output into place: " + ec.message(), mTarget);
+        if (ec)
+            throw Error(ErrorCode::WriteFailed, "cannot move the output into place: " + ec.message(),
+                        mTarget);
     }
     mCommitted = true;
 }
@@ -119,7 +128,8 @@ void StagedDirectory::commit() {
 std::string fileExtension(const std::string& path) {
     std::string ext = fs::path(path).extension().string();
     if (!ext.empty() && ext[0] == '.') ext.erase(0, 1);
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
     return ext;
 }
 

@@ -35,6 +35,9 @@ public:
     std::string file(const std::string& name) const { return mStaging + "/" + name; }
     /// Moves the staging directory to the target. @throw Error(WriteFailed)
     void commit();
+    /// Moves it to @p target instead (a sibling of the target: the same rules for what it may
+    /// replace), e.g. OUT.failed for an output that failed its checks. @throw Error(WriteFailed)
+    void commitAs(const std::string& target);
 
 private:
     std::string mTarget;

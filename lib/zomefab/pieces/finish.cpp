@@ -13,7 +13,7 @@ namespace zomefab::pieces::detail {
 namespace {
 
 /// The planes between the piece's cells and the others, outward into the other cell.
-std::vector<CutFace> cutPlanes(const GridCells& cells, const CellSet& set) {
+std::vector<CutFace> cutPlanes(const GridCells& cells, const CellSet& set, double seamGapMm) {
     const size_t cellCount = cells.count();
     std::vector<CutFace> planes;
     for (uint32_t k : set.members)
@@ -21,8 +21,12 @@ std::vector<CutFace> cutPlanes(const GridCells& cells, const CellSet& set) {
             if (set.isMember[j]) continue;
             const double inv = cells.invNorm[k * cellCount + j];
             if (inv <= 0) continue;
-            planes.push_back({scale(sub(cells.w[j], cells.w[k]), inv), (cells.b[j] - cells.b[k]) * inv, 0.0});
+            planes.push_back(
+                {scale(sub(cells.w[j], cells.w[k]), inv), (cells.b[j] - cells.b[k]) * inv + seamGapMm, 0.0});
         }
+    // A re-cut plane normal·x = offset is the plane normal·x − offset = 0.
+    for (const CellSet::HalfSpace& h : set.halfSpaces)
+        planes.push_back({h.normal, seamGapMm - h.offsetMm, 0.0});
     return planes;
 }
 
@@ -37,10 +41,27 @@ std::vector<CutFace> cutPlanes(const GridCells& cells, const CellSet& set) {
                     "--printer-mm, --fit-margin-mm)");
 }
 
+/// The cut face on the bed made exactly flat: where the mesher's rounding put a vertex up to the
+/// flat tolerance beyond the face's plane (at a rim), it is moved onto the plane, and the plane is
+/// z = 0. The face then prints as the first layer whole.
+void flattenBase(TriMesh& mesh, const std::vector<CutFace>& faces, const PrintOrientation& orientation,
+                 Piece& piece) {
+    const auto face = std::find_if(faces.begin(), faces.end(), [&](const CutFace& f) {
+        return dot(f.outwardNormal, orientation.downNormal) > 1 - 1e-12;
+    });
+    if (face == faces.end()) return;
+    // A point of the plane, in printer coordinates.
+    const double planeZ = orientation.transformMm.apply(scale(face->outwardNormal, -face->offsetMm))[2];
+    for (Vec3f& v : mesh.positions) v[2] = float(std::max(double(v[2]), planeZ) - planeZ);
+    Transform4d lift = Transform4d::identity();
+    lift.m[11] = -planeZ;
+    piece.gridToPrintMm = lift * orientation.transformMm;
+}
+
 }  // namespace
 
 std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, const CellSet& set,
-                        const Vec3d& printerMm, double voxel, const RunContext& context) {
+                        const Vec3d& printerMm, double voxel, double seamGapMm, const RunContext& context) {
     // Sealed pockets of a few voxels (seen up to 28 voxels, where a tenon prism meets a tilted
     // wall) would be printed as empty pockets and make admesh count extra parts: fill them. An
     // uncut closed shell keeps its hollow, which is far larger.
@@ -57,15 +78,19 @@ std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, cons
                         formatNumber(report.volume, 4) + " mm³)");
     piece.volumeMm3 = report.volume;
     piece.gridBoundsMm = boundingBox(mesh);
-    const std::vector<CutFace> faces = measureCutFaces(mesh, cutPlanes(cells, set), 0.05 * voxel);
+    const std::vector<CutFace> faces = measureCutFaces(mesh, cutPlanes(cells, set, seamGapMm), 0.05 * voxel);
     const PrintOrientation orientation = orientForPrinter(mesh, faces, printerMm);
     if (!orientation.fits) failFit(piece, orientation, printerMm);
-    piece.gridToPrintMm = orientation.transformMm;
+    piece.gridToPrintMm = orientation.transformMm;  // flattenBase may lift it a few hundredths
     piece.isCutFaceDown = orientation.isCutFaceDown;
     piece.downNormalGridMm = orientation.downNormal;
     piece.baseAreaMm2 = orientation.baseAreaMm2;
     piece.extentsMm = orientation.extentsMm;
     transformInPlace(mesh, orientation.transformMm);
+    if (orientation.isCutFaceDown) {
+        flattenBase(mesh, faces, orientation, piece);
+        piece.baseAreaMm2 = baseAreaMm2(mesh, {0, 0, -1});
+    }
     // The adaptive mesher can emit two points a float's rounding apart (seen where a tenon off the
     // lattice axes meets a curved wall); turned onto the bed they can round to the same point.
     // Welded, the zero-area triangles between them repeat a vertex and go, so the STL has no

@@ -3,6 +3,7 @@
 #include "zomefab/pieces/detail/grouping.h"
 
 #include <algorithm>
+#include <tuple>
 
 #include "zomefab/core/disjoint_sets.h"
 #include "zomefab/core/error.h"
@@ -188,7 +189,7 @@ std::vector<uint32_t> ownVoxels(VoxelField& field, const std::vector<Component>&
 /// The pieces' cells, requests and volumes, their cell sets, and who shares a cut face with whom.
 void describePieces(Grouping& out, const std::vector<Component>& comps,
                     const std::vector<uint32_t>& pieceOfComp, const std::vector<uint32_t>& cellPieceCount,
-                    const Contacts& contacts, size_t requestCount, double voxelMm) {
+                    size_t requestCount, double voxelMm) {
     const double voxelVolume = voxelMm * voxelMm * voxelMm;
     const size_t cellCount = cellPieceCount.size();
     for (size_t c = 0; c < comps.size(); ++c) {
@@ -213,20 +214,55 @@ void describePieces(Grouping& out, const std::vector<Component>& comps,
             if (!set.isMember[k] || cellPieceCount[k] > 1) set.cutters.push_back(k);
         }
     }
-    std::map<std::pair<uint32_t, uint32_t>, size_t> pieceContacts;
-    for (const auto& [pair, count] : contacts) {
-        const uint32_t a = pieceOfComp[pair.first], b = pieceOfComp[pair.second];
-        if (a != b) pieceContacts[{std::min(a, b), std::max(a, b)}] += count;
-    }
-    for (const auto& [pair, count] : pieceContacts) {
-        const double area = double(count) * voxelMm * voxelMm;
-        out.pieces[pair.first].neighbors.push_back({pair.second, area});
-        out.pieces[pair.second].neighbors.push_back({pair.first, area});
-    }
-    for (Piece& piece : out.pieces) std::sort(piece.neighbors.begin(), piece.neighbors.end());
 }
 
 }  // namespace
+
+FaceContacts faceContacts(const VoxelField& field, const GridCells& cells, const std::vector<CellSet>& sets,
+                          std::vector<Piece>& pieces) {
+    // Voxel faces per (lower piece, higher piece, lower's cell, higher's cell); a pair in one cell
+    // is a re-cut face (its plane is one of the pieces' half-spaces).
+    std::map<std::tuple<uint32_t, uint32_t, uint32_t, uint32_t>, size_t> counts;
+    forEachForwardPair(field, [&](size_t a, size_t b) {
+        if (!field.isInside(a) || !field.isInside(b) || field.owner[a] == field.owner[b]) return;
+        if (field.owner[a] > field.owner[b]) std::swap(a, b);
+        ++counts[{field.owner[a], field.owner[b], field.cell[a], field.cell[b]}];
+    });
+    FaceContacts faces;
+    std::map<std::pair<uint32_t, uint32_t>, size_t> total;
+    for (const auto& [key, count] : counts) {
+        const auto [pa, pb, ca, cb] = key;
+        Vec3d normal{0, 0, 0};
+        if (ca != cb) {
+            normal = normalized(sub(cells.w[cb], cells.w[ca]));  // the plane s_ca = s_cb, into cb
+        } else {
+            // The plane a was re-cut along that b lies beyond (b's side of it).
+            const auto& mine = sets[pa].halfSpaces;
+            const auto& theirs = sets[pb].halfSpaces;
+            for (const CellSet::HalfSpace& h : mine)
+                for (const CellSet::HalfSpace& g : theirs)
+                    if (dot(h.normal, g.normal) < -0.999999 && std::abs(h.offsetMm + g.offsetMm) < 1e-6)
+                        normal = h.normal;
+        }
+        if (norm(normal) == 0.0) continue;
+        auto& list = faces[{pa, pb}];
+        auto same = std::find_if(list.begin(), list.end(),
+                                 [&](const CutContact& c) { return dot(c.normal, normal) > 0.999999; });
+        if (same == list.end())
+            list.push_back({normal, count});
+        else
+            same->voxelFaces += count;
+        total[{pa, pb}] += count;
+    }
+    const double voxelArea = field.voxelMm * field.voxelMm;
+    for (Piece& piece : pieces) piece.neighbors.clear();
+    for (const auto& [pair, count] : total) {
+        pieces[pair.first].neighbors.push_back({pair.second, double(count) * voxelArea});
+        pieces[pair.second].neighbors.push_back({pair.first, double(count) * voxelArea});
+    }
+    for (Piece& piece : pieces) std::sort(piece.neighbors.begin(), piece.neighbors.end());
+    return faces;
+}
 
 std::vector<Component> findComponents(VoxelField& field) {
     const size_t slotCount = field.phi.size();
@@ -334,7 +370,8 @@ Grouping groupPieces(VoxelField& field, const GridCells& cells, const std::vecto
         out.pieces[p].sliversMerged = merger.rootSlivers[roots[p]];
     }
     const std::vector<uint32_t> cellPieceCount = ownVoxels(field, comps, pieceOfComp, cells.count());
-    describePieces(out, comps, pieceOfComp, cellPieceCount, contacts, requests.size(), field.voxelMm);
+    describePieces(out, comps, pieceOfComp, cellPieceCount, requests.size(), field.voxelMm);
+    out.faces = faceContacts(field, cells, out.cellSets, out.pieces);
     context.info(std::to_string(out.pieces.size()) + " pieces from " + std::to_string(comps.size()) +
                  " components of " + std::to_string(cells.count()) + " cells (" +
                  std::to_string(out.sliversMerged) + " slivers merged)");

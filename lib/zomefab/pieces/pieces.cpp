@@ -75,10 +75,10 @@ void checkInputs(const sdf::LevelSet& shell, const Transform4d& frameToGridMm,
 /// engraved numbers it cannot resolve (a warning).
 PiecesOptions optionsForVoxel(const PiecesOptions& options, double voxel, const RunContext& context) {
     PiecesOptions opt = options;
-    if (opt.tenons.maxPerPiece > 0 && voxel > maxVoxelForPegsMm(opt.tenons))
-        throw Error(ErrorCode::Usage, "tenon pegs " + formatNumber(pegShortMm(opt.tenons), 4) +
-                                          " mm thick need a voxel of at most " +
-                                          formatNumber(maxVoxelForPegsMm(opt.tenons), 4) +
+    if (opt.tenons.maxPerPiece > 0 && voxel > maxVoxelForTenonsMm(opt.tenons))
+        throw Error(ErrorCode::Usage, "tenon prisms " + formatNumber(opt.tenons.bodyWidthMm, 4) +
+                                          " mm wide need a voxel of at most " +
+                                          formatNumber(maxVoxelForTenonsMm(opt.tenons), 4) +
                                           " mm, but the shell's voxel is " + formatNumber(voxel, 4) +
                                           " mm: rebuild it finer (zf-sdf --voxel-mm) or turn tenons off");
     if (opt.label.isEnabled && opt.label.strokeMm < 2.0 * voxel) {
@@ -101,7 +101,7 @@ std::vector<PieceGrid> pieceGrids(const Pieces& out, const VoxelField& field, co
                       [&](const tbb::blocked_range<size_t>& range) {
                           for (size_t p = range.begin(); p < range.end(); ++p) {
                               context.throwIfCancelled();
-                              grids[p] = pieceGrid(field, cells, cellSets[p], out.pieces[p], pieceLeaves[p],
+                              grids[p] = pieceGrid(field, cells, cellSets, out.pieces[p], pieceLeaves[p],
                                                    shell.transform(), out.options);
                           }
                       });
@@ -131,8 +131,10 @@ void meshPieces(Pieces& out, std::vector<PieceGrid>& grids, const GridCells& cel
                 tbb::this_task_arena::isolate(
                     [&] { mesh = sdf::meshFloatGrid(*grids[p].grid, meshing, grids[p].fullResolution); });
                 grids[p] = PieceGrid();
+                // The pegs as exact meshes, overlapping the meshed prisms (tenons.h, pegMesh).
+                for (const Tenon& t : out.pieces[p].tenons) appendMesh(mesh, pegMesh(t, out.options.tenons));
                 notes[p] = finishPiece(out.pieces[p], std::move(mesh), cells, cellSets[p], out.printerMm,
-                                       voxel, context);
+                                       voxel, out.options.seamGapMm, context);
                 context.progress("pieces", 0.5 + 0.45 * double(++meshed) / double(pieceCount));
             }
         });
@@ -153,10 +155,22 @@ void meshPieces(Pieces& out, std::vector<PieceGrid>& grids, const GridCells& cel
 void checkPiecesOptions(const PiecesOptions& o) {
     if (!(o.minPieceVolumeMm3 >= 0 && std::isfinite(o.minPieceVolumeMm3)))
         throw Error(ErrorCode::Usage, "the smallest piece volume must be a finite number ≥ 0 mm³");
+    if (!(o.seamGapMm >= 0 && o.seamGapMm <= 2))
+        throw Error(ErrorCode::Usage,
+                    "the seam gap must be in [0, 2] mm, got " + formatNumber(o.seamGapMm, 4));
     if (!(o.adaptivity >= 0 && o.adaptivity <= 1))
         throw Error(ErrorCode::Usage, "adaptivity must be in [0, 1], got " + formatNumber(o.adaptivity, 4));
     checkTenonOptions(o.tenons);
     checkLabelOptions(o.label);
+}
+
+void requireBuildable(const Pieces& pieces) {
+    const std::vector<std::string>& problems = pieces.plan.problems;
+    if (problems.empty()) return;
+    std::string list;
+    for (size_t i = 0; i < problems.size() && i < 3; ++i) list += (i ? "; " : "") + problems[i];
+    if (problems.size() > 3) list += "; and " + std::to_string(problems.size() - 3) + " more";
+    throw Error(ErrorCode::ProcessingFailed, "the pieces cannot be put on the frame: " + list);
 }
 
 Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
@@ -194,7 +208,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
     context.progress("pieces", 0.25);
     context.throwIfCancelled();
 
-    planPieces(out, field, *shell, frame, frameToGridMm, out.options, context);
+    planPieces(out, field, cells, grouping, *shell, frame, frameToGridMm, out.options, context);
     context.progress("pieces", 0.35);
     context.debug("tenons and labels planned: " + formatNumber(clock.seconds(), 3) + " s");
     context.throwIfCancelled();

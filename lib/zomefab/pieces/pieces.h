@@ -21,6 +21,7 @@
 #include "zomefab/core/run_context.h"
 #include "zomefab/core/transform.h"
 #include "zomefab/core/tri_mesh.h"
+#include "zomefab/mount/plan.h"
 #include "zomefab/partition/partition_result.h"
 #include "zomefab/pieces/label.h"
 #include "zomefab/pieces/tenons.h"
@@ -29,6 +30,13 @@
 
 namespace zomefab::pieces {
 
+/// How the pieces go onto the frame (docs/mounting.md).
+struct MountOptions {
+    /// Balls and struts are taken this much larger when a piece's path is tested (mm): what the
+    /// voxels and printing may be off by.
+    double frameMarginMm = 1.0;
+};
+
 struct PiecesOptions {
     /// Connected pieces with less volume are merged into the neighbour they share the largest cut
     /// face with (a 2 cm³ sliver is too small to carry a tenon or to print well). Never dropped:
@@ -36,6 +44,11 @@ struct PiecesOptions {
     double minPieceVolumeMm3 = 2000.0;
     TenonOptions tenons;
     LabelOptions label;
+    MountOptions mount;
+    /// Every cut face is moved this far into its piece (mm), so neighbours meet with twice this
+    /// gap: room for glue and for the printer's few tenths, and where three cells meet the two
+    /// meshes' voxel rounding does not make them overlap.
+    double seamGapMm = 0.15;
     /// volumeToMesh adaptivity: 0 = one vertex per surface voxel; larger merges flat regions into
     /// larger triangles (tenons and numbers stay at full resolution). 0.3 gives the bunny at 400 mm
     /// 24 MB of STL where 0 gives 121 MB (docs/pieces.md).
@@ -55,6 +68,9 @@ struct Piece {
     uint32_t sliversMerged = 0;   ///< small components merged into this piece
     double shellVolumeMm3 = 0.0;  ///< its part of the shell, counted in voxels
 
+    /// The direction the piece goes on along (−d): the zome hole whose direction is d; every
+    /// tenon of the piece uses it. −1 when no direction was found (the plan says why).
+    int hole = -1;
     std::vector<Tenon> tenons;
     /// When fewer than TenonOptions::minPerPiece tenons were found: why each candidate ray failed
     /// ("hole holds a strut" → 3, ...); empty otherwise.
@@ -88,11 +104,21 @@ struct Pieces {
     double outsideCellsVolumeMm3 = 0.0;
     size_t sliversMerged = 0;
     size_t isolatedSlivers = 0;  ///< small pieces with no neighbour to merge into (kept)
+    /// Pieces cut in two because the frame was in the way of every direction (docs/mounting.md):
+    /// each adds one piece to what the partition asked for.
+    size_t recutPieces = 0;
     Transform4d frameToGridMm;
     Transform4d gridTransformMm;  ///< the shell's LevelSetInfo::transformMm (input mesh → grid mm)
     PiecesOptions options;
+    /// The installation plan: every piece's direction, the mounting order, and what (if anything)
+    /// keeps the object from being built.
+    mount::InstallationPlan plan;
     double seconds = 0.0;
 };
+
+/// @throw Error(ProcessingFailed) "the pieces cannot be put on the frame: ..." naming the plan's
+/// problems, when @p pieces' installation plan has any (a tool writes no such pieces).
+void requireBuildable(const Pieces& pieces);
 
 /// Cuts @p shell into printable pieces (paper §6) that fit the Fabrication's printer.
 /// @param shell         the hollow shell level set (zf-shell), grid mm

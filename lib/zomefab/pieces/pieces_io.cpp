@@ -12,12 +12,37 @@
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/io/threemf.h"
 #include "zomefab/pieces/detail/box_distance.h"
+#include "zomefab/zome/holes.h"
 
 namespace zomefab::pieces {
 
 using nlohmann::json;
 
-namespace {}  // namespace
+namespace {
+
+/// A piece's direction as pieces.json writes it: the hole, its colour, the unit vector in frame
+/// and grid coordinates, and its name in words; null when it has none.
+json directionToJson(int hole, const Transform4d& frameToGridMm) {
+    if (hole < 0) return nullptr;
+    const Vec3d& d = zome::holeDirection(hole);
+    return {{"hole", hole},
+            {"color", zome::colorName(zome::holeColor(hole))},
+            {"frame", toJson(d)},
+            {"grid", toJson(normalized(applyLinear(frameToGridMm, d)))},
+            {"name", zome::directionName(d)}};
+}
+
+json installationToJson(const mount::InstallationPlan& plan) {
+    json steps = json::array();
+    for (const mount::MountStep& s : plan.steps) steps.push_back({{"pieces", s.pieces}, {"hole", s.hole}});
+    json before = json::array();
+    for (const auto& [a, b] : plan.before) before.push_back({a, b});
+    json glued = json::array();
+    for (const auto& [a, b] : plan.glued) glued.push_back({a, b});
+    return {{"steps", steps}, {"before", before}, {"glued", glued}, {"problems", plan.problems}};
+}
+
+}  // namespace
 
 std::string pieceName(const Pieces& pieces, size_t index) {
     size_t width = 2;
@@ -47,7 +72,9 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                      {{"min_per_piece", o.tenons.minPerPiece},
                       {"max_per_piece", o.tenons.maxPerPiece},
                       {"clearance_mm", o.tenons.clearanceMm},
-                      {"hole_mm", {o.tenons.holeLongMm, o.tenons.holeShortMm}},
+                      {"hole_mm",
+                       {2 * zome::holeSectionMm(zome::Color::Blue)[2][0],
+                        2 * zome::holeSectionMm(zome::Color::Blue)[2][1]}},
                       {"peg_mm", {pegLongMm(o.tenons), pegShortMm(o.tenons)}},
                       {"peg_depth_mm", o.tenons.pegDepthMm},
                       {"width_mm", o.tenons.bodyWidthMm},
@@ -55,7 +82,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                       {"max_tilt_deg", o.tenons.maxTiltDeg},
                       {"embed_mm", o.tenons.embedMm},
                       {"frame_clearance_mm", o.tenons.frameClearanceMm},
-                      {"holes", o.tenons.latticeHolesOnly ? "lattice" : "blue"}}},
+                      {"holes", tenonHolesName(o.tenons.holes)}}},
                     {"label",
                      {{"enabled", o.label.isEnabled},
                       {"height_mm", o.label.heightMm},
@@ -116,6 +143,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                             {"base_area_mm2", p.baseAreaMm2},
                             {"extents_mm", toJson(p.extentsMm)},
                             {"fits", true}}},
+                          {"direction", directionToJson(p.hole, all.frameToGridMm)},
                           {"cells", p.cells},
                           {"partition_pieces", p.requests},
                           {"neighbors", neighbors},
@@ -126,12 +154,14 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                           {"label_note", p.label ? json(nullptr) : json(p.labelNote)}});
     }
     j["pieces"] = pieces;
+    j["installation"] = installationToJson(all.plan);
     j["summary"] = {{"pieces", all.pieces.size()},
                     {"volume_mm3", total},
                     {"shell_volume_mm3", all.shellVolumeMm3},
                     {"outside_cells_volume_mm3", all.outsideCellsVolumeMm3},
                     {"slivers_merged", all.sliversMerged},
                     {"isolated_slivers", all.isolatedSlivers},
+                    {"recut_pieces", all.recutPieces},
                     {"tenons", tenonCount},
                     {"pieces_with_few_tenons", fewTenons},
                     {"labelled", labelled}};

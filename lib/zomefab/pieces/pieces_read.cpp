@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // pieces.json read back: the inverse of piecesToJson (pieces_io.cpp), for zf-preview, the
 // installation checks and anything else that starts from a pieces directory.
+#include <algorithm>
 #include <filesystem>
 
 #include "zomefab/core/error.h"
@@ -53,10 +54,6 @@ void readOptions(const json& o, PiecesOptions& options) {
     to.minPerPiece = intFromJson(requireMember(t, "min_per_piece", "tenons"), "tenons.min_per_piece");
     to.maxPerPiece = intFromJson(requireMember(t, "max_per_piece", "tenons"), "tenons.max_per_piece");
     to.clearanceMm = numberFromJson(requireMember(t, "clearance_mm", "tenons"), "tenons.clearance_mm");
-    const json& hole = requireMember(t, "hole_mm", "tenons");
-    if (!hole.is_array() || hole.size() != 2) fail("tenons.hole_mm must be [long, short]");
-    to.holeLongMm = numberFromJson(hole[0], "tenons.hole_mm");
-    to.holeShortMm = numberFromJson(hole[1], "tenons.hole_mm");
     to.pegDepthMm = numberFromJson(requireMember(t, "peg_depth_mm", "tenons"), "tenons.peg_depth_mm");
     to.bodyWidthMm = numberFromJson(requireMember(t, "width_mm", "tenons"), "tenons.width_mm");
     to.maxLengthMm = numberFromJson(requireMember(t, "max_length_mm", "tenons"), "tenons.max_length_mm");
@@ -64,7 +61,10 @@ void readOptions(const json& o, PiecesOptions& options) {
     to.embedMm = numberFromJson(requireMember(t, "embed_mm", "tenons"), "tenons.embed_mm");
     to.frameClearanceMm =
         numberFromJson(requireMember(t, "frame_clearance_mm", "tenons"), "tenons.frame_clearance_mm");
-    to.latticeHolesOnly = t.value("holes", "blue") == "lattice";
+    const std::string holes = t.value("holes", "all");
+    const auto parsed = tenonHolesFromName(holes);
+    if (!parsed) fail("tenons.holes must be lattice, blue or all, not \"" + holes + "\"");
+    to.holes = *parsed;
 }
 
 Tenon tenonFromJson(const json& j, uint32_t piece, const std::string& what) {
@@ -155,11 +155,58 @@ Piece pieceFromJson(const json& j, size_t index, const std::string& directory) {
     }
     if (j.contains("label_note") && j["label_note"].is_string())
         piece.labelNote = j["label_note"].get<std::string>();
+    const json& direction = j.value("direction", json());
+    if (direction.is_object()) {
+        piece.hole = intFromJson(requireMember(direction, "hole", what), what + ".direction.hole");
+        if (piece.hole < 0 || piece.hole >= zome::kHoleCount) fail(what + ".direction.hole must be in 0..61");
+    }
     const json& file = requireMember(j, "file", what);
     if (!file.is_string() || file.get<std::string>().find('/') != std::string::npos)
         fail(what + ".file must be a file name next to pieces.json");
     if (!directory.empty()) piece.mesh = readMesh((fs::path(directory) / file.get<std::string>()).string());
     return piece;
+}
+
+std::pair<uint32_t, uint32_t> indexPair(const json& j, size_t pieceCount, const std::string& what) {
+    if (!j.is_array() || j.size() != 2) fail(what + " must be a pair of piece indices");
+    const uint32_t a = indexFromJson(j[0], what), b = indexFromJson(j[1], what);
+    if (a >= pieceCount || b >= pieceCount) fail(what + " names a piece that does not exist");
+    return {a, b};
+}
+
+/// The installation plan of pieces.json ("installation"): its steps, order, glued pairs and
+/// problems; every piece's direction and group from the steps.
+mount::InstallationPlan planFromJson(const json& j, const std::vector<Piece>& pieces) {
+    mount::InstallationPlan plan;
+    const size_t n = pieces.size();
+    plan.holeOfPiece.assign(n, -1);
+    plan.groupOf.resize(n);
+    for (uint32_t p = 0; p < n; ++p) plan.groupOf[p] = p, plan.holeOfPiece[p] = pieces[p].hole;
+    const json& steps = requireMember(j, "steps", "installation");
+    if (!steps.is_array()) fail("installation.steps must be a list");
+    std::vector<uint8_t> isPlaced(n, 0);
+    for (size_t s = 0; s < steps.size(); ++s) {
+        const std::string what = "installation.steps[" + std::to_string(s) + "]";
+        mount::MountStep step;
+        step.pieces = indicesFromJson(requireMember(steps[s], "pieces", what), what + ".pieces");
+        step.hole = intFromJson(requireMember(steps[s], "hole", what), what + ".hole");
+        if (step.pieces.empty()) fail(what + ".pieces must not be empty");
+        if (step.hole < -1 || step.hole >= zome::kHoleCount) fail(what + ".hole must be in -1..61");
+        for (uint32_t p : step.pieces) {
+            if (p >= n) fail(what + " names piece " + std::to_string(p) + ", which does not exist");
+            if (isPlaced[p]) fail(what + " mounts piece " + std::to_string(p) + " a second time");
+            isPlaced[p] = 1;
+            plan.groupOf[p] = *std::min_element(step.pieces.begin(), step.pieces.end());
+        }
+        plan.steps.push_back(step);
+    }
+    for (const json& pair : j.value("before", json::array()))
+        plan.before.push_back(indexPair(pair, n, "installation.before"));
+    for (const json& pair : j.value("glued", json::array()))
+        plan.glued.push_back(indexPair(pair, n, "installation.glued"));
+    for (const json& problem : j.value("problems", json::array()))
+        plan.problems.push_back(problem.is_string() ? problem.get<std::string>() : problem.dump());
+    return plan;
 }
 
 }  // namespace
@@ -190,11 +237,13 @@ Pieces piecesFromJson(const json& j, const std::string& directory) {
         if (out.pieces.back().id != i)
             fail("pieces[" + std::to_string(i) + "].piece must be " + std::to_string(i));
     }
+    if (j.contains("installation")) out.plan = planFromJson(j["installation"], out.pieces);
     const json& summary = j.value("summary", json::object());
     out.shellVolumeMm3 = summary.value("shell_volume_mm3", 0.0);
     out.outsideCellsVolumeMm3 = summary.value("outside_cells_volume_mm3", 0.0);
     out.sliversMerged = summary.value("slivers_merged", size_t(0));
     out.isolatedSlivers = summary.value("isolated_slivers", size_t(0));
+    out.recutPieces = summary.value("recut_pieces", size_t(0));
     return out;
 }
 

@@ -4,7 +4,12 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 
+#include "zomefab/core/format.h"
+#include "zomefab/core/run_context.h"
+#include "zomefab/pieces/detail/mounting.h"
+#include "zomefab/pieces/detail/splits.h"
 #include "zomefab/pieces/detail/stages.h"
 
 namespace zomefab::pieces::detail {
@@ -35,11 +40,96 @@ void warnShortfall(const Pieces& out, const TenonOptions& o, const RunContext& c
                  " tenons (rejected rays: " + list + "); pieces.json lists why per piece");
 }
 
+constexpr int kRecutRounds = 3;  ///< plan, re-cut the blocked pieces, plan again: at most this often
+
+/// The box every piece's voxels and every ball lie in (grid mm): the frame sweeps' rectangle.
+Box3d planBounds(const VoxelField& field, const zome::Structure& frame, const Transform4d& frameToGridMm) {
+    Box3d bounds;
+    for (size_t s = 0; s < field.phi.size(); ++s)
+        if (field.isInside(s)) bounds.expand(field.world(field.coordOf(s)));
+    for (zome::BallId id : frame.ballIds()) bounds.expand(frameToGridMm.apply(frame.ball(id).positionMm));
+    return bounds;
+}
+
+/// Re-cuts the pieces the plan could not give a direction because the frame is in the way of
+/// every one (not for want of tenons). Returns how many were cut.
+size_t recutBlocked(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
+                    const PlannerInput& input, const std::vector<TenonCandidate>& candidates,
+                    const FrameSweeps& sweeps, const PiecesOptions& opt, const RunContext& context) {
+    SplitSearch search;
+    search.voxelMm = field.voxelMm;
+    search.originMm = field.originMm;
+    search.minVolumeMm3 =
+        std::max(opt.minPieceVolumeMm3, 1000.0 * field.voxelMm * field.voxelMm * field.voxelMm);
+    search.edgeMarginMm = bodyRadiusMm(opt.tenons) + field.voxelMm;
+    search.maxPerPiece = opt.tenons.maxPerPiece;
+    size_t cut = 0;
+    const size_t pieceCount = out.pieces.size();
+    for (uint32_t p = 0; p < pieceCount; ++p) {
+        if (out.plan.holeOfPiece[p] >= 0 || input.candidatesByHole[p].empty()) continue;
+        const MountBody alone = makeBody({p}, input, sweeps, field.voxelMm, opt.tenons.maxPerPiece);
+        if (alone.bestFree()) continue;  // held on its own: unheld only with its glued group
+        std::vector<const TenonCandidate*> mine;
+        for (const TenonCandidate& c : candidates)
+            if (c.piece == int64_t(p) && c.rejection.empty()) mine.push_back(&c);
+        context.throwIfCancelled();
+        std::vector<Vec3d> voxels;
+        for (size_t s = 0; s < field.phi.size(); ++s)
+            if (field.isInside(s) && field.owner[s] == p) voxels.push_back(field.world(field.coordOf(s)));
+        const std::optional<SplitPlane> plane = findSplit(voxels, mine, sweeps, search);
+        if (!plane) continue;
+        const uint32_t q = splitPiece(out.pieces, grouping.cellSets, field, p, *plane);
+        context.info("piece " + std::to_string(p) +
+                     " meets the frame along every direction: re-cut in two (" + std::to_string(p) + " and " +
+                     std::to_string(q) + ")");
+        ++cut;
+    }
+    out.recutPieces += cut;
+    if (cut > 0) grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
+    return cut;
+}
+
+/// The installation plan, re-cutting blocked pieces and planning again (a few rounds), and the
+/// tenons along each piece's direction.
+void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
+                           const ShellProbe& probe, const zome::Structure& frame,
+                           const Transform4d& frameToGridMm, const PiecesOptions& opt,
+                           const RunContext& context) {
+    const FrameSweeps sweeps(frame, frameToGridMm, planBounds(field, frame, frameToGridMm), field.voxelMm,
+                             opt.mount.frameMarginMm);
+    std::vector<TenonCandidate> candidates;
+    for (int round = 0;; ++round) {
+        const Stopwatch clock;
+        candidates = findTenonCandidates(frame, frameToGridMm, probe, opt.tenons);
+        const PlannerInput input = plannerInput(out, field, candidates);
+        context.debug("mounting: " + std::to_string(candidates.size()) + " tenon candidates in " +
+                      formatNumber(clock.seconds(), 3) + " s");
+        context.throwIfCancelled();
+        out.plan = planMounting(input, sweeps, grouping.faces, field.voxelMm, opt.tenons.minPerPiece,
+                                opt.tenons.maxPerPiece, context);
+        context.debug("mounting: plan " + std::to_string(round) + " in " + formatNumber(clock.seconds(), 3) +
+                      " s");
+        if (out.plan.isBuildable() || round == kRecutRounds) break;
+        const size_t cut = recutBlocked(out, field, cells, grouping, input, candidates, sweeps, opt, context);
+        context.debug("mounting: re-cut " + std::to_string(cut) + " in " + formatNumber(clock.seconds(), 3) +
+                      " s");
+        if (cut == 0) break;
+    }
+    TenonPlan plan = chooseTenons(candidates, out.plan.holeOfPiece, opt.tenons);
+    for (size_t p = 0; p < out.pieces.size(); ++p) {
+        out.pieces[p].hole = out.plan.holeOfPiece[p];
+        out.pieces[p].tenons = std::move(plan.perPiece[p]);
+        out.pieces[p].tenonShortfall = std::move(plan.shortfall[p]);
+    }
+    warnShortfall(out, opt.tenons, context);
+    for (const std::string& problem : out.plan.problems) context.warn("installation plan: " + problem);
+}
+
 }  // namespace
 
-void planPieces(Pieces& out, const VoxelField& field, const FloatGrid& shell, const zome::Structure& frame,
-                const Transform4d& frameToGridMm, const PiecesOptions& opt, const RunContext& context) {
-    const size_t pieceCount = out.pieces.size();
+void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
+                const FloatGrid& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
+                const PiecesOptions& opt, const RunContext& context) {
     const FloatGrid::ConstAccessor probeAccessor = shell.getConstAccessor();
     const openvdb::tools::GridSampler<FloatGrid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
         probeAccessor, shell.transform());
@@ -56,15 +146,12 @@ void planPieces(Pieces& out, const VoxelField& field, const FloatGrid& shell, co
         return int64_t(field.owner[s]);
     };
     if (opt.tenons.maxPerPiece > 0) {
-        const std::vector<TenonCandidate> candidates =
-            findTenonCandidates(frame, frameToGridMm, probe, opt.tenons);
-        TenonPlan plan = chooseTenons(candidates, pieceCount, opt.tenons);
-        for (size_t p = 0; p < pieceCount; ++p) {
-            out.pieces[p].tenons = std::move(plan.perPiece[p]);
-            out.pieces[p].tenonShortfall = std::move(plan.shortfall[p]);
-        }
-        warnShortfall(out, opt.tenons, context);
+        planMountingAndTenons(out, field, cells, grouping, probe, frame, frameToGridMm, opt, context);
+    } else {
+        out.plan.holeOfPiece.assign(out.pieces.size(), -1);
+        out.plan.problems.push_back("no tenons (--max-tenons 0): nothing holds the pieces on the frame");
     }
+    const size_t pieceCount = out.pieces.size();
     context.throwIfCancelled();
     if (!opt.label.isEnabled) return;
     const double reach = frame.scale().ballRadiusMm() + 3.0 * frame.scale().b0Mm;

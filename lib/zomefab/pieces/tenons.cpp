@@ -1,16 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Tenons (paper §6.1): candidate rays along the balls' blue holes, the collision and containment
-// tests, the greedy choice, and the tenon solid's signed distance.
+// Tenons (paper §6.1): candidate rays along the balls' holes, the collision and containment
+// tests, the choice along each piece's direction, and the tenon solid's signed distance.
 #include "zomefab/pieces/tenons.h"
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+#include <optional>
+#include <string_view>
 
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
 #include "zomefab/core/vec.h"
 #include "zomefab/pieces/detail/box_distance.h"
+#include "zomefab/zome/holes.h"
 #include "zomefab/zome/zome_system.h"
 
 namespace zomefab::pieces {
@@ -31,20 +33,14 @@ Vec3d ShellProbe::normalAt(const Vec3d& p) const {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-/// The lattice axes' blue holes: +x +y +z, then −x −y −z (zome_system.h numbering).
-constexpr int kLatticeHoles[6] = {0, 1, 2, 15, 16, 17};
-
-/// The holes a tenon may plug into: the six lattice ones first (the paper's), then the other 24 blue.
-std::vector<int> tenonHoles(const TenonOptions& o) {
-    std::vector<int> holes(std::begin(kLatticeHoles), std::end(kLatticeHoles));
-    if (o.latticeHolesOnly) return holes;
-    const auto [first, last] = zome::holeRange(zome::Color::Blue);
-    for (int hole = first; hole < last; ++hole)
-        if (std::find(holes.begin(), holes.end(), hole) == holes.end()) holes.push_back(hole);
-    return holes;
-}
-/// How far the peg reaches into the prism so that the union has no seam at the shoulder.
-constexpr double kPegOverlapMm = 0.5;
+/// The prism stops this short of the ball's face (mm): the voxel mesher rounds the concave edge
+/// where a prism would meet a peg into a fillet of up to half a voxel, which would sit in the hole's
+/// mouth; the exact peg mesh spans the gap instead.
+constexpr double kPrismGapMm = 0.3;
+/// How far the peg mesh reaches back into the prism (mm), so the two overlap.
+constexpr double kPegRootMm = 1.5;
+/// The chamfer around the peg's tip (mm, 45°): it finds the hole before the peg's full section does.
+constexpr double kPegChamferMm = 0.4;
 
 void requireRange(double value, double lo, double hi, const char* name, const char* unit) {
     if (!(value >= lo && value <= hi))
@@ -64,7 +60,129 @@ double bisect(const ShellProbe& probe, const Vec3d& origin, const Vec3d& dir, do
     return 0.5 * (t0 + t1);
 }
 
+/// Signed distance to a convex polygon (counter-clockwise) in its plane: the largest of its edge
+/// lines' distances. Exact inside, a lower bound outside.
+double polygonDistance(const std::vector<std::array<double, 2>>& poly, double x, double y) {
+    double d = -1e300;
+    for (size_t i = 0; i < poly.size(); ++i) {
+        const auto& a = poly[i];
+        const auto& b = poly[(i + 1) % poly.size()];
+        const double ex = b[0] - a[0], ey = b[1] - a[1], len = std::hypot(ex, ey);
+        d = std::max(d, ((x - a[0]) * ey - (y - a[1]) * ex) / len);  // > 0 right of a→b: outside
+    }
+    return d;
+}
+
+/// The tenon of @p ball along @p hole before the shell is asked: axes, ball centre, shoulder, tip.
+Tenon tenonAlong(const zome::Structure& frame, zome::BallId id, int hole, const Transform4d& frameToGridMm,
+                 const TenonOptions& o) {
+    Tenon t;
+    t.ball = id;
+    t.hole = hole;
+    t.axisFrame = zome::holeDirection(hole);
+    t.axisGrid = normalized(applyLinear(frameToGridMm, t.axisFrame));
+    t.longSideGrid = normalized(applyLinear(frameToGridMm, zome::holeSectionAxis(hole)));
+    t.ballCenterGridMm = frameToGridMm.apply(frame.ball(id).positionMm);
+    t.shoulderMm = frame.scale().ballRadiusMm() * zome::holeFaceRatio(zome::holeColor(hole));
+    t.pegTipMm = t.shoulderMm - o.pegDepthMm;
+    return t;
+}
+
+/// The prism stays in its piece: wherever it is inside the shell it is this piece's, and its end
+/// face lies in this piece's wall with at least half a voxel of wall beyond. The rejection, or empty.
+std::string containment(const Tenon& t, int64_t piece, const ShellProbe& probe, const TenonOptions& o) {
+    const double step = 0.5 * probe.voxelMm, halfWidth = 0.5 * o.bodyWidthMm;
+    const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
+    bool isEndOutside = false;
+    const int lateral = 4;  // 5 × 5 samples across the section
+    for (int i = 0; i <= lateral; ++i)
+        for (int j = 0; j <= lateral; ++j) {
+            const double l = -halfWidth + 2 * halfWidth * i / lateral,
+                         s = -halfWidth + 2 * halfWidth * j / lateral;
+            const Vec3d offset = add(scale(t.longSideGrid, l), scale(shortSide, s));
+            for (double a = t.shoulderMm; a <= t.endMm + 1e-9; a += step) {
+                const Vec3d q = add(t.pointAt(a), offset);
+                if (probe.signedDistanceMm(q) < 0 && probe.pieceAt(q) != piece)
+                    return "crosses another piece";
+            }
+            const Vec3d e = add(t.pointAt(t.endMm), offset);
+            if (!(probe.signedDistanceMm(e) < -0.5 * probe.voxelMm) || probe.pieceAt(e) != piece)
+                isEndOutside = true;
+        }
+    return isEndOutside ? "too close to the piece's edge" : "";
+}
+
+/// One ray's candidate: where it meets the wall, which piece, and why it cannot be a tenon.
+TenonCandidate candidateAlong(const zome::Structure& frame, zome::BallId id, int hole,
+                              const Transform4d& frameToGridMm, const ShellProbe& probe,
+                              const TenonOptions& o) {
+    TenonCandidate c;
+    c.tenon = tenonAlong(frame, id, hole, frameToGridMm, o);
+    Tenon& t = c.tenon;
+    const double step = 0.5 * probe.voxelMm;
+    // March from the ball's face to the first point inside the shell: the inner surface. Rays look
+    // twice as far as a tenon may reach, so "too far" is told apart from "no wall".
+    if (probe.signedDistanceMm(t.pointAt(t.shoulderMm)) < 0) {
+        c.piece = probe.pieceAt(t.pointAt(t.shoulderMm));
+        c.rejection = "the ball's face is inside the wall";
+        return c;
+    }
+    double hit = -1;
+    for (double s = t.shoulderMm + step; s <= t.shoulderMm + 2.0 * o.maxLengthMm; s += step)
+        if (probe.signedDistanceMm(t.pointAt(s)) < 0) {
+            hit = bisect(probe, t.ballCenterGridMm, t.axisGrid, s - step, s);
+            break;
+        }
+    if (hit < 0) return c.rejection = "no wall within reach", c;
+    t.baseMm = hit;
+    c.piece = probe.pieceAt(t.pointAt(hit + 0.5 * probe.voxelMm));
+    if (c.piece < 0) c.piece = probe.pieceAt(t.pointAt(hit + probe.voxelMm));
+    t.piece = c.piece < 0 ? 0 : uint32_t(c.piece);
+    if (c.piece < 0) return c.rejection = "no piece at the wall", c;
+    if (!frame.isHoleFree(id, hole)) return c.rejection = "hole holds a strut", c;
+    if (t.lengthMm() > o.maxLengthMm) return c.rejection = "too far from the wall", c;
+    // The inner surface's normal (out of the wall, into the cavity) by central differences.
+    const Vec3d n = probe.normalAt(t.pointAt(hit));
+    const double cosTilt = std::clamp(-dot(t.axisGrid, n), -1.0, 1.0);
+    t.tiltDeg = std::acos(cosTilt) * 180.0 / kPi;
+    if (!(t.tiltDeg <= o.maxTiltDeg)) return c.rejection = "surface too oblique", c;
+    // Deep enough that the whole end face is in the wall on a tilted surface.
+    t.endMm = hit + o.embedMm + bodyRadiusMm(o) * std::tan(t.tiltDeg * kPi / 180.0);
+    const std::string obstruction = tenonObstruction(frame, t, o);
+    if (!obstruction.empty())
+        return c.rejection = obstruction.rfind("strut", 0) == 0 ? "strut in the way" : "ball in the way", c;
+    c.rejection = containment(t, c.piece, probe, o);
+    if (c.rejection.empty()) c.score = cosTilt - 0.5 * t.lengthMm() / o.maxLengthMm;
+    return c;
+}
+
 }  // namespace
+
+const char* tenonHolesName(TenonHoles holes) {
+    switch (holes) {
+        case TenonHoles::Lattice:
+            return "lattice";
+        case TenonHoles::Blue:
+            return "blue";
+        case TenonHoles::All:
+            return "all";
+    }
+    return "all";
+}
+
+std::optional<TenonHoles> tenonHolesFromName(std::string_view name) {
+    for (TenonHoles h : {TenonHoles::Lattice, TenonHoles::Blue, TenonHoles::All})
+        if (name == tenonHolesName(h)) return h;
+    return std::nullopt;
+}
+
+std::vector<int> tenonHoleSet(TenonHoles holes) {
+    if (holes == TenonHoles::Lattice) return {0, 1, 2, 15, 16, 17};  // ±x ±y ±z (zome_system.h numbering)
+    std::vector<int> out;
+    const int last = holes == TenonHoles::Blue ? zome::holeRange(zome::Color::Blue).second : zome::kHoleCount;
+    for (int h = 0; h < last; ++h) out.push_back(h);
+    return out;
+}
 
 void checkTenonOptions(const TenonOptions& o) {
     if (o.minPerPiece < 0 || o.minPerPiece > 62)
@@ -78,12 +196,6 @@ void checkTenonOptions(const TenonOptions& o) {
                                           ") is below the number wanted (" + std::to_string(o.minPerPiece) +
                                           ")");
     requireRange(o.clearanceMm, 0.0, 0.5, "the tenon clearance", "mm");
-    requireRange(o.holeLongMm, 1.0, 20.0, "the hole's long side", "mm");
-    requireRange(o.holeShortMm, 1.0, o.holeLongMm, "the hole's short side", "mm");
-    if (pegShortMm(o) < 1.0)
-        throw Error(ErrorCode::Usage,
-                    "the peg (hole less twice the clearance) must be at least 1 mm thick, got " +
-                        formatNumber(pegShortMm(o)) + " mm");
     requireRange(o.pegDepthMm, 1.0, 8.0, "the peg depth", "mm");
     requireRange(o.bodyWidthMm, pegLongMm(o), 20.0, "the tenon width", "mm");
     requireRange(o.maxLengthMm, 1.0, 200.0, "the longest tenon", "mm");
@@ -92,25 +204,64 @@ void checkTenonOptions(const TenonOptions& o) {
     requireRange(o.frameClearanceMm, 0.0, 10.0, "the tenon's clearance to the frame", "mm");
 }
 
+double pegLongMm(const TenonOptions& o) {
+    const auto section = zome::holeSectionMm(zome::Color::Blue);
+    return section[1][0] - section[0][0] - 2 * o.clearanceMm;
+}
+
+double pegShortMm(const TenonOptions& o) {
+    const auto section = zome::holeSectionMm(zome::Color::Blue);
+    return section[2][1] - section[1][1] - 2 * o.clearanceMm;
+}
+
 double bodyRadiusMm(const TenonOptions& o) { return o.bodyWidthMm * std::sqrt(0.5); }
+
+std::vector<std::array<double, 2>> pegSectionMm(int hole, const TenonOptions& o) {
+    return zome::insetPolygon(zome::holeSectionMm(zome::holeColor(hole)), o.clearanceMm);
+}
 
 double tenonSignedDistanceMm(const Tenon& t, const TenonOptions& o, const Vec3d& p) {
     const Vec3d d = sub(p, t.ballCenterGridMm);
     const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
     const double a = dot(d, t.axisGrid), l = dot(d, t.longSideGrid), s = dot(d, shortSide);
-    const double bodyMid = 0.5 * (t.shoulderMm + t.endMm), bodyHalf = 0.5 * (t.endMm - t.shoulderMm);
-    const double body =
-        boxDistance({a - bodyMid, l, s}, {bodyHalf, 0.5 * o.bodyWidthMm, 0.5 * o.bodyWidthMm});
-    const double pegEnd = t.shoulderMm + kPegOverlapMm;
-    const double pegMid = 0.5 * (t.pegTipMm + pegEnd), pegHalf = 0.5 * (pegEnd - t.pegTipMm);
-    const double peg = boxDistance({a - pegMid, l, s}, {pegHalf, 0.5 * pegLongMm(o), 0.5 * pegShortMm(o)});
-    return std::min(body, peg);
+    const double start = t.shoulderMm + kPrismGapMm;
+    const double bodyMid = 0.5 * (start + t.endMm), bodyHalf = 0.5 * (t.endMm - start);
+    return boxDistance({a - bodyMid, l, s}, {bodyHalf, 0.5 * o.bodyWidthMm, 0.5 * o.bodyWidthMm});
+}
+
+TriMesh pegMesh(const Tenon& t, const TenonOptions& o) {
+    const std::vector<std::array<double, 2>> side = pegSectionMm(t.hole, o);
+    const std::vector<std::array<double, 2>> tip = zome::insetPolygon(side, kPegChamferMm);
+    const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
+    TriMesh m;
+    auto ring = [&](const std::vector<std::array<double, 2>>& poly, double along) {
+        for (const auto& q : poly) {
+            const Vec3d x = madd(madd(t.pointAt(along), q[0], t.longSideGrid), q[1], shortSide);
+            m.positions.push_back({float(x[0]), float(x[1]), float(x[2])});
+        }
+    };
+    // Rings from the root (in the prism, away from the ball) to the tip (in the hole).
+    ring(side, t.shoulderMm + kPegRootMm);
+    ring(side, t.pegTipMm + kPegChamferMm);
+    ring(tip, t.pegTipMm);
+    const uint32_t n = uint32_t(side.size());
+    // Counter-clockwise seen from +axis: the root cap faces +axis, the tip cap −axis.
+    for (uint32_t k = 1; k + 1 < n; ++k) m.triangles.push_back({0, k, k + 1});
+    for (uint32_t k = 1; k + 1 < n; ++k) m.triangles.push_back({2 * n, 2 * n + k + 1, 2 * n + k});
+    for (uint32_t r = 0; r < 2; ++r)
+        for (uint32_t k = 0; k < n; ++k) {
+            const uint32_t k1 = (k + 1) % n;
+            const uint32_t top = r * n, bottom = (r + 1) * n;  // top: nearer the root
+            m.triangles.push_back({bottom + k, bottom + k1, top + k1});
+            m.triangles.push_back({bottom + k, top + k1, top + k});
+        }
+    return m;
 }
 
 Box3d tenonBoundsMm(const Tenon& t, const TenonOptions& o) {
     Box3d box;
     const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
-    const double half = 0.5 * o.bodyWidthMm;  // ≥ the peg's half sections (checkTenonOptions)
+    const double half = 0.5 * o.bodyWidthMm;  // ≥ every peg's half section (checkTenonOptions)
     for (double a : {t.pegTipMm, t.endMm})
         for (double l : {-half, half})
             for (double s : {-half, half})
@@ -143,122 +294,15 @@ std::vector<TenonCandidate> findTenonCandidates(const zome::Structure& frame,
                                                 const Transform4d& frameToGridMm, const ShellProbe& probe,
                                                 const TenonOptions& o) {
     std::vector<TenonCandidate> out;
-    const double voxel = probe.voxelMm;
-    const double step = 0.5 * voxel;
-    const double shoulder = frame.scale().ballRadiusMm();
-    // Rays look twice as far as a tenon may reach, so "too far" is told apart from "no wall".
-    const double reach = shoulder + 2.0 * o.maxLengthMm;
-    const double halfWidth = 0.5 * o.bodyWidthMm;
-    const std::vector<int> holes = tenonHoles(o);
-    for (zome::BallId id : frame.ballIds()) {
-        const zome::Ball& ball = frame.ball(id);
-        const Vec3d center = frameToGridMm.apply(ball.positionMm);
-        for (int hole : holes) {
-            TenonCandidate c;
-            Tenon& t = c.tenon;
-            t.ball = id;
-            t.hole = hole;
-            t.axisFrame = zome::holeDirection(hole);
-            t.axisGrid = normalized(applyLinear(frameToGridMm, t.axisFrame));
-            t.longSideGrid = normalized(applyLinear(frameToGridMm, zome::holeSectionAxis(hole)));
-            t.ballCenterGridMm = center;
-            t.shoulderMm = shoulder;
-            t.pegTipMm = shoulder - o.pegDepthMm;
-            const Vec3d& u = t.axisGrid;
-            auto reject = [&](const char* why) {
-                c.rejection = why;
-                out.push_back(c);
-            };
-
-            // March from the ball's face to the first point inside the shell: the inner surface.
-            if (probe.signedDistanceMm(t.pointAt(shoulder)) < 0) {
-                c.piece = probe.pieceAt(t.pointAt(shoulder));
-                reject("the ball's face is inside the wall");
-                continue;
-            }
-            double hit = -1;
-            for (double s = shoulder + step; s <= reach; s += step) {
-                if (probe.signedDistanceMm(t.pointAt(s)) < 0) {
-                    hit = bisect(probe, center, u, s - step, s);
-                    break;
-                }
-            }
-            if (hit < 0) {
-                reject("no wall within reach");
-                continue;
-            }
-            t.baseMm = hit;
-            c.piece = probe.pieceAt(t.pointAt(hit + 0.5 * voxel));
-            if (c.piece < 0) c.piece = probe.pieceAt(t.pointAt(hit + voxel));
-            t.piece = c.piece < 0 ? 0 : uint32_t(c.piece);
-            if (c.piece < 0) {
-                reject("no piece at the wall");
-                continue;
-            }
-            if (!frame.isHoleFree(id, hole)) {
-                reject("hole holds a strut");
-                continue;
-            }
-            if (t.lengthMm() > o.maxLengthMm) {
-                reject("too far from the wall");
-                continue;
-            }
-            // The inner surface's normal (out of the wall, into the cavity) by central differences.
-            const Vec3d p = t.pointAt(hit);
-            const Vec3d n = probe.normalAt(p);
-            const double cosTilt = std::clamp(-dot(u, n), -1.0, 1.0);
-            t.tiltDeg = std::acos(cosTilt) * 180.0 / kPi;
-            if (!(t.tiltDeg <= o.maxTiltDeg)) {
-                reject("surface too oblique");
-                continue;
-            }
-            // Deep enough that the whole end face is in the wall on a tilted surface.
-            t.endMm = hit + o.embedMm + bodyRadiusMm(o) * std::tan(t.tiltDeg * kPi / 180.0);
-
-            const std::string obstruction = tenonObstruction(frame, t, o);
-            if (!obstruction.empty()) {
-                reject(obstruction.rfind("strut", 0) == 0 ? "strut in the way" : "ball in the way");
-                continue;
-            }
-            // Containment: wherever the prism is inside the shell it is inside this piece, and its
-            // end face lies in this piece's wall with at least half a voxel of wall beyond.
-            const Vec3d shortSide = cross(u, t.longSideGrid);
-            bool crossesOther = false, isEndOutside = false;
-            const int lateral = 4;  // 5 × 5 samples across the section
-            for (int i = 0; i <= lateral && !crossesOther; ++i) {
-                for (int j = 0; j <= lateral && !crossesOther; ++j) {
-                    const double l = -halfWidth + 2 * halfWidth * i / lateral;
-                    const double s = -halfWidth + 2 * halfWidth * j / lateral;
-                    const Vec3d offset = add(scale(t.longSideGrid, l), scale(shortSide, s));
-                    for (double a = shoulder; a <= t.endMm + 1e-9; a += step) {
-                        const Vec3d q = add(t.pointAt(a), offset);
-                        if (probe.signedDistanceMm(q) < 0 && probe.pieceAt(q) != c.piece) {
-                            crossesOther = true;
-                            break;
-                        }
-                    }
-                    const Vec3d e = add(t.pointAt(t.endMm), offset);
-                    if (!(probe.signedDistanceMm(e) < -0.5 * voxel) || probe.pieceAt(e) != c.piece)
-                        isEndOutside = true;
-                }
-            }
-            if (crossesOther) {
-                reject("crosses another piece");
-                continue;
-            }
-            if (isEndOutside) {
-                reject("too close to the piece's edge");
-                continue;
-            }
-            c.score = cosTilt - 0.5 * t.lengthMm() / o.maxLengthMm;
-            out.push_back(c);
-        }
-    }
+    const std::vector<int> holes = tenonHoleSet(o.holes);
+    for (zome::BallId id : frame.ballIds())
+        for (int hole : holes) out.push_back(candidateAlong(frame, id, hole, frameToGridMm, probe, o));
     return out;
 }
 
-TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, size_t pieceCount,
+TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, const std::vector<int>& holeOfPiece,
                        const TenonOptions& o) {
+    const size_t pieceCount = holeOfPiece.size();
     TenonPlan plan;
     plan.perPiece.assign(pieceCount, {});
     plan.shortfall.assign(pieceCount, {});
@@ -267,56 +311,62 @@ TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, size_t pie
     for (size_t i = 0; i < candidates.size(); ++i) {
         rejection[i] = candidates[i].rejection;
         const int64_t p = candidates[i].piece;
-        if (p >= 0 && size_t(p) < pieceCount && rejection[i].empty()) byPiece[size_t(p)].push_back(i);
+        if (p < 0 || size_t(p) >= pieceCount || candidates[i].tenon.hole != holeOfPiece[size_t(p)]) continue;
+        if (rejection[i].empty()) byPiece[size_t(p)].push_back(i);
     }
-    // Best first; ties by (ball, hole) through the candidates' order.
-    for (auto& list : byPiece)
-        std::stable_sort(list.begin(), list.end(),
-                         [&](size_t x, size_t y) { return candidates[x].score > candidates[y].score; });
-
     std::vector<const Tenon*> chosen;
     const double minGap = 2 * bodyRadiusMm(o) + o.frameClearanceMm;
     auto conflicts = [&](const Tenon& t) {
-        for (const Tenon* c : chosen) {
-            const double d2 = zome::segmentSegmentDistanceSq(t.pointAt(t.shoulderMm), t.pointAt(t.endMm),
-                                                             c->pointAt(c->shoulderMm), c->pointAt(c->endMm));
-            if (d2 < minGap * minGap) return true;
-        }
+        for (const Tenon* c : chosen)
+            if (zome::segmentSegmentDistanceSq(t.pointAt(t.shoulderMm), t.pointAt(t.endMm),
+                                               c->pointAt(c->shoulderMm),
+                                               c->pointAt(c->endMm)) < minGap * minGap)
+                return true;
         return false;
     };
+    // How much a candidate spreads the piece's tenons: its distance to the balls already chosen,
+    // and for a third, to their line (three not on one line hold the piece against turning).
+    auto spread = [&](const std::vector<Tenon>& mine, const Tenon& t) {
+        if (mine.empty()) return 0.0;
+        double nearest = 1e300;
+        for (const Tenon& m : mine)
+            nearest = std::min(nearest, norm(sub(t.ballCenterGridMm, m.ballCenterGridMm)));
+        double offLine = 0.0;
+        if (mine.size() >= 2) {
+            const Vec3d axis = normalized(sub(mine[1].ballCenterGridMm, mine[0].ballCenterGridMm));
+            offLine = norm(cross(axis, sub(t.ballCenterGridMm, mine[0].ballCenterGridMm)));
+        }
+        return std::min(1.0, nearest / 100.0) + std::min(1.0, offLine / 100.0);
+    };
     std::vector<uint8_t> isTaken(candidates.size(), 0);
-    // Round-robin: every piece gets its k-th tenon before any gets its (k+1)-th. After the first,
-    // a piece prefers tenons parallel to it (one insertion direction, docs/pieces.md).
-    for (int round = 0; round < o.maxPerPiece; ++round) {
+    // Round-robin: every piece gets its k-th tenon before any gets its (k+1)-th.
+    for (int round = 0; round < o.maxPerPiece; ++round)
         for (size_t p = 0; p < pieceCount; ++p) {
             if (plan.perPiece[p].size() != size_t(round)) continue;
-            const int firstHole = round == 0 ? -1 : plan.perPiece[p].front().hole;
-            for (int pass = 0; pass < 2; ++pass) {
-                bool isDone = false;
-                for (size_t i : byPiece[p]) {
-                    if (isTaken[i] || !rejection[i].empty()) continue;
-                    const bool isParallel = candidates[i].tenon.hole == firstHole;
-                    if (firstHole >= 0 && pass == 0 && !isParallel) continue;
-                    if (conflicts(candidates[i].tenon)) {
-                        rejection[i] = "another tenon in the way";
-                        continue;
-                    }
-                    isTaken[i] = 1;
-                    plan.perPiece[p].push_back(candidates[i].tenon);
-                    chosen.push_back(&candidates[i].tenon);
-                    isDone = true;
-                    break;
+            size_t best = SIZE_MAX;
+            double bestKey = -1e300;
+            for (size_t i : byPiece[p]) {
+                if (isTaken[i] || !rejection[i].empty()) continue;
+                if (conflicts(candidates[i].tenon)) {
+                    rejection[i] = "another tenon in the way";
+                    continue;
                 }
-                if (isDone || firstHole < 0) break;
+                const double key = candidates[i].score + spread(plan.perPiece[p], candidates[i].tenon);
+                if (key > bestKey + 1e-12) bestKey = key, best = i;
             }
+            if (best == SIZE_MAX) continue;
+            isTaken[best] = 1;
+            plan.perPiece[p].push_back(candidates[best].tenon);
+            chosen.push_back(&candidates[best].tenon);
         }
-    }
     for (size_t p = 0; p < pieceCount; ++p) {
         if (plan.perPiece[p].size() >= size_t(o.minPerPiece)) continue;
         auto& reasons = plan.shortfall[p];
         for (size_t i = 0; i < candidates.size(); ++i)
-            if (candidates[i].piece == int64_t(p) && !rejection[i].empty()) ++reasons[rejection[i]];
-        if (reasons.empty()) reasons["no blue hole of a ball points at this piece"] = 1;
+            if (candidates[i].piece == int64_t(p) && candidates[i].tenon.hole == holeOfPiece[p] &&
+                !rejection[i].empty())
+                ++reasons[rejection[i]];
+        if (reasons.empty()) reasons["no ball's hole along the piece's direction points at it"] = 1;
     }
     return plan;
 }

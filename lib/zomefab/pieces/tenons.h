@@ -1,16 +1,21 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-/// @file Tenons (paper §6.1): from the frame's balls, rays along the blue holes (all 30 by default;
-/// the paper's 6 lattice axes with latticeHolesOnly) find the pieces' inner surface; where it is met
-/// nearly perpendicularly, the hole
-/// is free and nothing of the frame is in the way, a tenon is grown: a square prism from the wall
-/// to the ball's blue face, ending in a peg with the golden-rectangle section of the blue hole.
-/// No OpenVDB here: the shell is queried through ShellProbe. docs/pieces.md, "Tenons".
+/// @file Tenons (paper §6.1, made mountable): every piece is pushed onto the built frame along one
+/// direction, −d, with d one of the 62 hole directions; every tenon of the piece is a ray from a
+/// ball along d, through the ball's hole that points along d. Every ball has the same orientation,
+/// so these tenons are parallel by construction. Where the ray meets the piece's inner surface
+/// not too obliquely, the hole is free and nothing of the frame is in the way, a tenon is grown: a
+/// square prism from the wall to the ball's face, ending in a peg with the hole's own section —
+/// the blue golden rectangle, the yellow triangle or the red pentagon, less the clearance on
+/// every side. No OpenVDB here: the shell is queried through ShellProbe. docs/pieces.md, "Tenons".
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "zomefab/core/transform.h"
@@ -19,58 +24,65 @@
 
 namespace zomefab::pieces {
 
+/// Which hole directions a piece may be mounted along (and so its tenons use).
+enum class TenonHoles : uint8_t {
+    Lattice,  ///< the six lattice axes ±x ±y ±z, the paper's "all of 6 slots"
+    Blue,     ///< the 30 blue holes
+    All,      ///< all 62: blue, yellow and red, so some direction is within about 20° of any normal
+};
+const char* tenonHolesName(TenonHoles holes);
+/// The inverse of tenonHolesName; empty for any other name.
+std::optional<TenonHoles> tenonHolesFromName(std::string_view name);
+
 /// Dimensions and limits of the tenons (defaults: docs/pieces.md, "Tenon design").
 struct TenonOptions {
-    int minPerPiece = 2;          ///< aim: pieces with fewer are reported, with the reasons
-    int maxPerPiece = 4;          ///< 0 = no tenons
-    /// Gap between the peg and the hole on every side; the peg is the hole less twice this.
+    int minPerPiece = 2;  ///< aim: pieces with fewer are reported, with the reasons
+    int maxPerPiece = 4;  ///< 0 = no tenons
+    /// Gap between the peg and the hole on every side; the peg is the hole's section inset by this.
+    /// With a 4 mm peg, 0.15 mm lets the piece go on up to about 2° off its direction.
     double clearanceMm = 0.15;
-    /// The blue hole's golden rectangle: the blue strut's section in vZome's lifelike model,
-    /// 1/φ × 1/φ² vZome units at 8.8365 mm (../shared/docs/zome-geometry.md §3).
-    double holeLongMm = 5.46;
-    double holeShortMm = 3.38;
-    double pegDepthMm = 4.0;      ///< how far the peg enters the hole (ZomeFab's LATCH, 4 mm)
-    double bodyWidthMm = 7.0;     ///< side of the square prism from the wall to the ball's face
-    double maxLengthMm = 40.0;    ///< longest prism, from the ball's blue face to the inner surface
-    /// Largest angle between the hole axis and the inner surface's normal (§6.1: "perpendicular";
-    /// the paper's voxel surfaces were axis-aligned). 35° gives 10 of the bunny's 33 pieces fewer
-    /// than 2 tenons where 30° gives 13 (docs/pieces.md); the prism's end is buried deeper on a
-    /// tilted wall, so the bond does not suffer.
+    double pegDepthMm = 4.0;    ///< how far the peg enters the hole (ZomeFab's LATCH, 4 mm)
+    double bodyWidthMm = 7.0;   ///< side of the square prism from the wall to the ball's face
+    double maxLengthMm = 40.0;  ///< longest prism, from the ball's face to the inner surface
+    /// Largest angle between the tenon's axis and the inner surface's normal (§6.1: "perpendicular").
+    /// The prism's end is buried deeper on a tilted wall, so the bond does not suffer.
     double maxTiltDeg = 35.0;
     /// Depth of the prism in the wall beyond the axis's surface point, on top of what a tilted
     /// surface needs to bury the whole end face.
     double embedMm = 1.5;
-    double frameClearanceMm = 0.5; ///< extra gap between the prism and struts or other balls
-    /// true: only the six lattice-axis holes (±x ±y ±z), as the paper (§6.1); false: all 30 blue
-    /// holes, which reach walls the lattice axes meet too obliquely (docs/pieces.md, "Tenons").
-    bool latticeHolesOnly = false;
+    double frameClearanceMm = 0.5;  ///< extra gap between the prism and struts or other balls
+    TenonHoles holes = TenonHoles::All;
 };
 
 /// @throw Error(Usage) naming the option when a value is out of range.
 void checkTenonOptions(const TenonOptions& options);
 
-/// The peg's section: the hole less the clearance on every side.
-inline double pegLongMm(const TenonOptions& o) { return o.holeLongMm - 2 * o.clearanceMm; }
-inline double pegShortMm(const TenonOptions& o) { return o.holeShortMm - 2 * o.clearanceMm; }
-/// Coarsest shell voxel that still resolves the pegs: two voxels across their short side.
-inline double maxVoxelForPegsMm(const TenonOptions& o) { return 0.5 * pegShortMm(o); }
+/// The holes of @p holes (ascending).
+std::vector<int> tenonHoleSet(TenonHoles holes);
+
+/// The blue peg's section: the hole less the clearance on every side (long and short side, mm).
+double pegLongMm(const TenonOptions& o);
+double pegShortMm(const TenonOptions& o);
+/// Coarsest shell voxel that still resolves the tenons' prisms: two voxels across. (The pegs are
+/// exact meshes of their own, pegMesh, whatever the voxel.)
+inline double maxVoxelForTenonsMm(const TenonOptions& o) { return 0.5 * o.bodyWidthMm; }
 /// Radius of the capsule around the prism that the collision tests use (its half-diagonal).
 double bodyRadiusMm(const TenonOptions& o);
 
 /// One tenon. Distances are along the axis from the ball's centre, in mm.
 struct Tenon {
     zome::BallId ball = zome::kNoId;
-    int hole = 0;                  ///< a blue hole, 0..29 (zome_system.h numbering)
+    int hole = 0;  ///< 0..61 (zome_system.h numbering): the piece's direction
     uint32_t piece = 0;
-    Vec3d axisFrame{0, 0, 1};      ///< zome::holeDirection(hole): exact, frame coordinates
-    Vec3d axisGrid{0, 0, 1};       ///< the same in the grid's mm (rotated by frameToGridMm)
-    Vec3d longSideGrid{1, 0, 0};   ///< the peg's long side (grid): zome::holeSectionAxis(hole), rotated
+    Vec3d axisFrame{0, 0, 1};     ///< zome::holeDirection(hole): exact, frame coordinates
+    Vec3d axisGrid{0, 0, 1};      ///< the same in the grid's mm (rotated by frameToGridMm)
+    Vec3d longSideGrid{1, 0, 0};  ///< the section's x axis (grid): zome::holeSectionAxis(hole), rotated
     Vec3d ballCenterGridMm{0, 0, 0};
-    double shoulderMm = 0.0;       ///< the ball's blue face, where the prism ends and the peg starts
-    double baseMm = 0.0;           ///< where the axis meets the inner surface
-    double endMm = 0.0;            ///< where the prism ends inside the wall
-    double pegTipMm = 0.0;         ///< the peg's end in the hole: shoulderMm − pegDepthMm
-    double tiltDeg = 0.0;          ///< angle between the axis and the inner surface's normal
+    double shoulderMm = 0.0;  ///< the ball's face around the hole, where the prism ends and the peg starts
+    double baseMm = 0.0;      ///< where the axis meets the inner surface
+    double endMm = 0.0;       ///< where the prism ends inside the wall
+    double pegTipMm = 0.0;    ///< the peg's end in the hole: shoulderMm − pegDepthMm
+    double tiltDeg = 0.0;     ///< angle between the axis and the inner surface's normal
 
     double lengthMm() const { return baseMm - shoulderMm; }
     Vec3d pointAt(double t) const {
@@ -79,9 +91,19 @@ struct Tenon {
     }
 };
 
-/// Signed distance to the tenon solid (prism ∪ peg), negative inside, in the grid's mm. Exact
-/// outside each box, and where one box is nearest inside.
+/// The peg's section for @p hole: its hole's section (zome::holeSectionMm) inset by the clearance,
+/// in the section's frame (x along longSideGrid, y = axis × x), mm.
+std::vector<std::array<double, 2>> pegSectionMm(int hole, const TenonOptions& options);
+
+/// Signed distance to the tenon's prism, negative inside, in the grid's mm: the square prism from
+/// just short of the ball's face (0.3 mm) to its end in the wall; exact. The peg is not in it: a
+/// few voxels across, a voxel mesh would round it by a tenth of its clearance (pegMesh).
 double tenonSignedDistanceMm(const Tenon& tenon, const TenonOptions& options, const Vec3d& pGridMm);
+
+/// The peg as an exact closed mesh (grid mm, outward): its section (pegSectionMm) extruded from
+/// 1.5 mm inside the prism to the tip, with a 0.4 mm chamfer round the tip. It overlaps the
+/// meshed prism, as a second shell of the piece's mesh (slicers print the union).
+TriMesh pegMesh(const Tenon& tenon, const TenonOptions& options);
 /// Axis-aligned box (grid mm) around the tenon solid.
 Box3d tenonBoundsMm(const Tenon& tenon, const TenonOptions& options);
 
@@ -98,7 +120,7 @@ struct ShellProbe {
     Vec3d normalAt(const Vec3d& p) const;
 };
 
-/// One ray from a ball along a lattice hole: the tenon it would be, and why not (empty = usable).
+/// One ray from a ball along a hole: the tenon it would be, and why not (empty = usable).
 struct TenonCandidate {
     Tenon tenon;
     int64_t piece = -1;     ///< the piece the ray meets, −1 when it meets none
@@ -106,9 +128,10 @@ struct TenonCandidate {
     double score = 0.0;     ///< larger is better: perpendicular and short
 };
 
-/// All 6 lattice rays of every ball, in (ball id, hole) order.
-std::vector<TenonCandidate> findTenonCandidates(const zome::Structure& frame, const Transform4d& frameToGridMm,
-                                                const ShellProbe& probe, const TenonOptions& options);
+/// The rays of every ball along every hole of options.holes, in (ball id, hole) order.
+std::vector<TenonCandidate> findTenonCandidates(const zome::Structure& frame,
+                                                const Transform4d& frameToGridMm, const ShellProbe& probe,
+                                                const TenonOptions& options);
 
 /// What is in the way of @p tenon's prism (as a capsule of bodyRadiusMm from the shoulder to its end):
 /// "strut 12 (B0) in the way", "ball 4 in the way", or empty when the path is clear.
@@ -121,9 +144,12 @@ struct TenonPlan {
     std::vector<std::map<std::string, int>> shortfall;
 };
 
-/// Picks tenons greedily: first up to minPerPiece for every piece, then up to maxPerPiece, best
-/// score first, skipping any that would come within 2 · bodyRadiusMm of one already chosen (the
-/// prisms of different pieces must not touch). Deterministic.
-TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, size_t pieceCount, const TenonOptions& options);
+/// Picks the tenons of every piece among the candidates along its direction @p holeOfPiece[p]
+/// (−1: none), greedily: round-robin over the pieces, best score first, preferring a ball far
+/// from the ones already chosen (three not on one line hold best), skipping any that would come
+/// within 2 · bodyRadiusMm of one already chosen (the prisms of different pieces must not touch).
+/// Deterministic.
+TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, const std::vector<int>& holeOfPiece,
+                       const TenonOptions& options);
 
 }  // namespace zomefab::pieces

@@ -31,15 +31,22 @@ GridCells toGridCells(const partition::LinearCells& model, const Transform4d& fr
     return c;
 }
 
-double regionDistance(const GridCells& c, const CellSet& set, const Vec3d& x, bool isMember, double* scores) {
-    const uint32_t own = c.owner(x, scores);
+double regionDistance(const GridCells& c, const CellSet& set, const Vec3d& x, double* scores) {
+    c.owner(x, scores);
     const size_t n = c.count();
-    double m = std::numeric_limits<double>::infinity();
-    for (uint32_t j : isMember ? set.cutters : set.members) {
-        const double inv = j == own ? 0.0 : c.invNorm[own * n + j];
-        if (inv > 0) m = std::min(m, (scores[own] - scores[j]) * inv);
+    // min over member cells k of max over the cutting cells j of the signed distance to the plane
+    // s_k = s_j: each max is zero exactly on cell k's boundary (a convex polytope), so the min is
+    // zero exactly on the boundary of the union, also where three cells meet.
+    double best = std::numeric_limits<double>::infinity();
+    for (uint32_t k : set.members) {
+        double m = -std::numeric_limits<double>::infinity();
+        for (uint32_t j : set.cutters) {
+            const double inv = j == k ? 0.0 : c.invNorm[k * n + j];
+            if (inv > 0) m = std::max(m, (scores[j] - scores[k]) * inv);
+        }
+        best = std::min(best, m);
     }
-    return isMember ? -m : m;
+    return best;
 }
 
 VoxelField buildField(const FloatGrid& shell) {

@@ -14,8 +14,19 @@
 
 namespace zomefab::pipeline {
 
-std::vector<std::string> writeRunOutputs(const report::RunRecord& run, const RunOptions& options,
-                                         const nlohmann::json& report, const std::string& outDir) {
+namespace {
+
+/// OUT.failed for OUT (a trailing slash dropped).
+std::string failedDirectory(const std::string& outDir) {
+    std::string base = outDir;
+    while (base.size() > 1 && base.back() == '/') base.pop_back();
+    return base + ".failed";
+}
+
+}  // namespace
+
+RunOutputs writeRunOutputs(const report::RunRecord& run, const RunOptions& options, nlohmann::json report,
+                           const std::string& outDir, const RunContext& context) {
     StagedDirectory staged(outDir, kRunMarkerFile);
     std::vector<std::string> written;
     auto write = [&](const std::string& name, const std::function<void(std::ostream&)>& body) {
@@ -47,10 +58,16 @@ std::vector<std::string> writeRunOutputs(const report::RunRecord& run, const Run
         out << report::assemblyGuideMarkdown(run.assembly, options.cost.prices);
     });
     write("cost.md", [&](std::ostream& out) { out << report::costPage(run); });
+    // The verifier reads back what was written, as `zomefab check` would.
+    RunOutputs result;
+    result.verification = verify::verifyAssembly(verify::readAssembly(staged.path()), {}, context);
+    report["verify"] = verify::verifyReportJson(result.verification);
     write(kRunMarkerFile, [&](std::ostream& out) { out << report.dump(2) << '\n'; });
-    staged.commit();
+    result.directory = result.verification.passed() ? outDir : failedDirectory(outDir);
+    staged.commitAs(result.directory);
     std::sort(written.begin(), written.end());
-    return written;
+    result.files = std::move(written);
+    return result;
 }
 
 }  // namespace zomefab::pipeline

@@ -117,12 +117,12 @@ void checkRunOptions(const RunOptions& options) {
     pieces::checkPiecesOptions(options.pieces);
     if (options.frame.chains < 1) throw Error(ErrorCode::Usage, "--chains must be at least 1");
     // The pieces stage would find this out only after the level sets; say it before any work.
-    const double maxVoxelMm = pieces::maxVoxelForPegsMm(options.pieces.tenons);
+    const double maxVoxelMm = pieces::maxVoxelForTenonsMm(options.pieces.tenons);
     if (options.pieces.tenons.maxPerPiece > 0 && options.field.voxelMm > maxVoxelMm)
         throw Error(ErrorCode::Usage,
-                    "--voxel-mm " + formatNumbers("%g", options.field.voxelMm) + ": the tenon pegs (" +
-                        formatNumbers("%.2f", pieces::pegShortMm(options.pieces.tenons)) +
-                        " mm thick) need a voxel of at most " + formatNumbers("%.2f", maxVoxelMm) + " mm");
+                    "--voxel-mm " + formatNumbers("%g", options.field.voxelMm) + ": the tenon prisms (" +
+                        formatNumbers("%.2f", options.pieces.tenons.bodyWidthMm) +
+                        " mm wide) need a voxel of at most " + formatNumbers("%.2f", maxVoxelMm) + " mm");
     report::checkCostOptions(options.cost);
 }
 

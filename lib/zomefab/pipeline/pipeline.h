@@ -20,6 +20,7 @@
 #include "zomefab/report/preview_scene.h"
 #include "zomefab/report/run_record.h"
 #include "zomefab/sdf/level_set.h"
+#include "zomefab/verify/verify.h"
 
 namespace zomefab::pipeline {
 
@@ -47,13 +48,22 @@ report::RunRecord runPipeline(const TriMesh& input, const std::string& sourceNam
 /// The file every zomefab run directory holds; its presence allows replacing the directory.
 inline constexpr const char* kRunMarkerFile = "report.json";
 
-/// Writes every output file of @p run into @p outDir (frame.json, frame.vef, partition.json,
-/// pieces/ with piece-NN.stl and pieces.json, pieces.3mf, preview.glb, assembly.md, cost.md,
-/// report.json = @p report, report::runReportJson) through a staging directory, so a failure leaves no
-/// half-written directory (an existing output directory of zomefab is replaced; any other existing non-empty
-/// directory is refused). The same writers as the stage tools, so a chain of them writes the same bytes.
-/// Returns the file names written, sorted. @throw Error(WriteFailed)
-std::vector<std::string> writeRunOutputs(const report::RunRecord& run, const RunOptions& options,
-                                         const nlohmann::json& report, const std::string& outDir);
+/// What writeRunOutputs did: the files, the verifier's findings on them, and where they went.
+struct RunOutputs {
+    std::vector<std::string> files;  ///< names written, sorted
+    verify::VerifyReport verification;
+    std::string directory;  ///< outDir, or outDir + ".failed" when the verification failed
+};
+
+/// Writes every output file of @p run (frame.json, frame.vef, partition.json, pieces/ with
+/// piece-NN.stl and pieces.json, pieces.3mf, preview.glb, assembly.md, cost.md, report.json =
+/// @p report, report::runReportJson, with the verifier's findings added as "verify") into a staging
+/// directory, runs the verifier on the files written (docs/mounting.md) and moves the directory
+/// to @p outDir when they pass, else to @p outDir + ".failed" for inspection. A failure to write
+/// leaves no half-written directory (an existing output directory of zomefab is replaced; any
+/// other existing non-empty directory is refused). The same writers as the stage tools, so a
+/// chain of them writes the same bytes. @throw Error(WriteFailed)
+RunOutputs writeRunOutputs(const report::RunRecord& run, const RunOptions& options, nlohmann::json report,
+                           const std::string& outDir, const RunContext& context);
 
 }  // namespace zomefab::pipeline

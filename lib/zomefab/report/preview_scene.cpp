@@ -13,6 +13,7 @@
 #include "zomefab/core/format.h"
 #include "zomefab/core/vec.h"
 #include "zomefab/core/version.h"
+#include "zomefab/zome/holes.h"
 #include "zomefab/zome/parts.h"
 
 namespace zomefab::report {
@@ -149,29 +150,6 @@ GlbMesh prismMesh(const std::string& name, const std::vector<std::array<double, 
 
 }  // namespace
 
-std::vector<std::array<double, 2>> strutCrossSection(zome::Color color) {
-    const double pi = std::acos(-1.0);
-    std::vector<std::array<double, 2>> s;
-    auto regular = [&](int n, double circumradius) {
-        for (int k = 0; k < n; ++k) {
-            const double a = 2.0 * pi * k / n;  // corner 0 on +x
-            s.push_back({circumradius * std::cos(a), circumradius * std::sin(a)});
-        }
-    };
-    switch (color) {
-        case zome::Color::Blue:  // golden rectangle 1/φ × 1/φ² vZome units (docs/zome.md §3)
-            s = {{-2.73, -1.69}, {2.73, -1.69}, {2.73, 1.69}, {-2.73, 1.69}};
-            break;
-        case zome::Color::Yellow:  // equilateral, edge = the blue rectangle's long side
-            regular(3, 5.46 / std::sqrt(3.0));
-            break;
-        case zome::Color::Red:  // vZome lifelike model: maximum radius 2.87 mm
-            regular(5, 2.87);
-            break;
-    }
-    return s;
-}
-
 GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& options) {
     if (!input.pieceNames.empty() && input.pieceNames.size() != input.pieces.size())
         throw Error(ErrorCode::Usage, "preview: " + std::to_string(input.pieceNames.size()) +
@@ -280,7 +258,7 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
                                                           " mm) is wider than a " +
                                                           zome::partName(s.color, s.size) + " strut is long");
                     GlbMesh prismMeshValue = prismMesh("strut-" + zome::partName(s.color, s.size),
-                                                       strutCrossSection(s.color), lengthMm);
+                                                       zome::holeSectionMm(s.color), lengthMm);
                     int& colour = strutMaterial[size_t(s.color)];
                     if (colour < 0) {
                         const auto& rgb = strutRgb[size_t(s.color)];

@@ -36,12 +36,6 @@ struct PreviewOptions {
     std::string generator;               ///< asset.generator; empty = "zomefab <version>"
 };
 
-/// Cross-section of a strut as a convex polygon (counter-clockwise, mm) in the plane normal to
-/// the strut: x points along zome::holeSectionAxis() of the hole. Blue: the
-/// golden rectangle 5.46 × 3.38 mm; yellow: the equilateral triangle of edge 5.46 mm (circumradius
-/// 3.15 mm); red: the regular pentagon of circumradius 2.87 mm (docs/zome.md §3, vZome's models).
-std::vector<std::array<double, 2>> strutCrossSection(zome::Color color);
-
 /// Builds the scene. Node names: "piece-NN" (or pieceNames), "ball-<id>", "strut-<id>" with the
 /// frame's ids; group nodes "zomefab" (root), "pieces", "balls", "struts".
 /// @throw Error(Usage) when pieceNames or pieceTransforms has the wrong size, a piece is empty, or the

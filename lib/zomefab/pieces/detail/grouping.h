@@ -36,11 +36,28 @@ double assignGroups(std::vector<Component>& comps, const VoxelField& field,
                     const std::vector<partition::Piece>& requests, size_t cellCount,
                     const Transform4d& gridToFrame, double growMm, double voxelVolumeMm3);
 
+/// One planar cut face between two pieces: its normal, from the lower piece into the higher, and
+/// its size in voxel faces.
+struct CutContact {
+    Vec3d normal{0, 0, 1};
+    size_t voxelFaces = 0;
+};
+/// The cut faces between pieces: for the pieces (a, b), a < b, one entry per plane they share,
+/// the plane between a cell of a and a cell of b, or a plane one was re-cut along
+/// (docs/mounting.md, "Order").
+using FaceContacts = std::map<std::pair<uint32_t, uint32_t>, std::vector<CutContact>>;
+
+/// The cut faces between the pieces that own the inside voxels of @p field, with their planes
+/// from @p cells and @p sets, and every piece's neighbours with the contact areas (mm²).
+FaceContacts faceContacts(const VoxelField& field, const GridCells& cells, const std::vector<CellSet>& sets,
+                          std::vector<Piece>& pieces);
+
 /// What the grouping made: the pieces (ids, cells, requests, neighbours, slivers, shell volume),
-/// their cell sets, and the merge counts.
+/// their cell sets, the cut faces between them, and the merge counts.
 struct Grouping {
     std::vector<Piece> pieces;
     std::vector<CellSet> cellSets;
+    FaceContacts faces;
     double shellVolumeMm3 = 0.0;
     double outsideCellsVolumeMm3 = 0.0;
     size_t sliversMerged = 0;

@@ -10,16 +10,20 @@
 #include <vector>
 
 #include "zomefab/core/run_context.h"
+#include "zomefab/pieces/detail/grouping.h"
 #include "zomefab/pieces/detail/voxels.h"
 #include "zomefab/pieces/pieces.h"
 #include "zomefab/zome/structure.h"
 
 namespace zomefab::pieces::detail {
 
-/// Tenons (paper §6.1) and engraved numbers of every piece of @p out, against the shell @p shell
-/// and the voxel owners of @p field. Warnings for pieces short of tenons or numbers.
-void planPieces(Pieces& out, const VoxelField& field, const FloatGrid& shell, const zome::Structure& frame,
-                const Transform4d& frameToGridMm, const PiecesOptions& options, const RunContext& context);
+/// The installation plan (every piece's direction and the order, docs/mounting.md; pieces the
+/// frame is in the way of re-cut, which changes @p field's owners and @p grouping's cell sets and
+/// faces), then the tenons (paper §6.1) along each piece's direction and the engraved numbers,
+/// against the shell @p shell. Warnings for pieces short of tenons or numbers.
+void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
+                const FloatGrid& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
+                const PiecesOptions& options, const RunContext& context);
 
 /// For every piece, the leaves that hold its inside voxels and their 26 neighbours (the band is
 /// three voxels wide).
@@ -31,15 +35,15 @@ struct PieceGrid {
     FloatGrid::Ptr grid;
     openvdb::BoolTree::Ptr fullResolution;
 };
-PieceGrid pieceGrid(const VoxelField& field, const GridCells& cells, const CellSet& set, const Piece& piece,
-                    const std::vector<uint32_t>& leaves, const openvdb::math::Transform& transform,
-                    const PiecesOptions& options);
+PieceGrid pieceGrid(const VoxelField& field, const GridCells& cells, const std::vector<CellSet>& sets,
+                    const Piece& piece, const std::vector<uint32_t>& leaves,
+                    const openvdb::math::Transform& transform, const PiecesOptions& options);
 
 /// Checks @p mesh (closed, outward; sealed pockets filled), measures its cut faces, turns it onto
 /// the printer's bed and stores it in @p piece. Returns the orientation's note (empty when a cut
 /// face lies on the bed). @throw Error(ProcessingFailed) naming the piece when its mesh is not
 /// closed or it fits @p printerMm in no orientation.
 std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, const CellSet& set,
-                        const Vec3d& printerMm, double voxelMm, const RunContext& context);
+                        const Vec3d& printerMm, double voxelMm, double seamGapMm, const RunContext& context);
 
 }  // namespace zomefab::pieces::detail

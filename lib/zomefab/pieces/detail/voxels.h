@@ -53,14 +53,22 @@ struct CellSet {
     std::vector<uint8_t> isMember;  ///< per cell
     std::vector<uint32_t> members;  ///< cells of the piece
     std::vector<uint32_t> cutters;  ///< cells whose planes may bound it: non-members and shared members
+    /// Planes the piece was re-cut along (a piece no direction could mount, split in two; see
+    /// detail/splits.h): the piece is its cells' region ∩ {x : normal·x ≤ offsetMm} for each.
+    struct HalfSpace {
+        Vec3d normal{0, 0, 1};  ///< unit, out of the piece
+        double offsetMm = 0.0;
+    };
+    std::vector<HalfSpace> halfSpaces;
 };
 
-/// δ_P: a signed distance to the piece's region (negative inside). @p isMember says whether the
-/// voxel belongs to the piece (its owner). Near a cut face it is the exact distance to the face's
-/// plane (s_own − s_j)/|w_own − w_j|; farther away a lower bound with the right sign, which is all
-/// the mesher needs. Two pieces sharing a face see the same plane, so their faces coincide.
-/// @p scores: scratch of size K.
-double regionDistance(const GridCells& c, const CellSet& set, const Vec3d& x, bool isMember, double* scores);
+/// δ_P: a signed distance to the region of the piece's cells (negative inside), from the planes
+/// between its member cells and the cutting cells: min over members k of max over cutters j of
+/// (s_j − s_k)/|w_j − w_k|. Exact near a cut face; a bound with the right sign farther away, and
+/// zero exactly on the region's boundary, where three cells meet too, so the mesh's cut faces are
+/// planar up to the crease lines. Two pieces sharing a face see the same plane. @p scores: scratch
+/// of size K.
+double regionDistance(const GridCells& c, const CellSet& set, const Vec3d& x, double* scores);
 
 /// A leaf's key in VoxelField::leafIndex.
 inline uint64_t leafKey(const Coord& origin) {

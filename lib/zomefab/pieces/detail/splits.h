@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file Re-cutting a piece no direction can mount (internal to lib/zomefab/pieces): a piece whose
+/// wall wraps around part of the frame (a ring around a limb, a cap over a ball) meets a ball or a
+/// strut along every direction. Cut in two by a plane, each half can often be pushed on from its
+/// own side. The halves are new pieces: the cells' region of the old one, each intersected with
+/// one side of the plane (CellSet::halfSpaces), so the new cut face is exactly planar and both
+/// halves see the same plane. docs/mounting.md, "Re-cut pieces".
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "zomefab/pieces/detail/grouping.h"
+#include "zomefab/pieces/detail/mounting.h"
+#include "zomefab/pieces/detail/voxels.h"
+
+namespace zomefab::pieces::detail {
+
+/// A cut plane: the part with normal·x > offsetMm becomes the new piece (grid mm).
+struct SplitPlane {
+    Vec3d normal{0, 0, 1};
+    double offsetMm = 0.0;
+};
+
+/// What a split search needs beyond the piece itself.
+struct SplitSearch {
+    double voxelMm = 1.0;
+    Vec3d originMm{0, 0, 0};       ///< the voxel grid's origin (to find voxel neighbours)
+    double minVolumeMm3 = 2000.0;  ///< each half at least this (PiecesOptions::minPieceVolumeMm3)
+    /// Tenon candidates whose wall point lies closer than this to the plane are lost with the cut.
+    double edgeMarginMm = 6.0;
+    int maxPerPiece = 4;
+};
+
+/// The best plane that cuts the piece of @p voxels (all its inside voxels' centres) into two
+/// connected halves, each with a free direction along
+/// which at least one of its tenon candidates (@p candidates: the piece's usable ones) holds it,
+/// the one whose weaker half has the most tenons. Planes tried: 13 directions (the axes, the face
+/// and the body diagonals of the grid) through the median of the piece's voxels along each, then
+/// through its thirds. Empty when none works.
+std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
+                                    const std::vector<const TenonCandidate*>& candidates,
+                                    const FrameSweeps& sweeps, const SplitSearch& search);
+
+/// Cuts piece @p p along @p plane: its voxels beyond the plane (inside and band) go to a new piece
+/// with the next id, its cell set with the other half-space; shell volumes recounted. Returns the
+/// new piece's id. The caller recomputes the face contacts (faceContacts).
+uint32_t splitPiece(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field, uint32_t p,
+                    const SplitPlane& plane);
+
+}  // namespace zomefab::pieces::detail

@@ -1,0 +1,184 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The installation plan on the shell's voxels: bodies, their directions and the frame sweeps
+// (detail/mounting.h, docs/mounting.md).
+#include "zomefab/pieces/detail/mounting.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+#include "zomefab/core/format.h"
+#include "zomefab/zome/holes.h"
+
+namespace zomefab::pieces::detail {
+
+namespace {
+
+constexpr uint32_t kStrutBit = 0x80000000u;
+
+Vec3d gridDirection(int hole, const Transform4d& frameToGridMm) {
+    return normalized(applyLinear(frameToGridMm, zome::holeDirection(hole)));
+}
+
+/// The rearmost point of a voxel's cube along @p d, relative to its centre.
+double halfDepth(const Vec3d& d, double voxelMm) {
+    return 0.5 * voxelMm * (std::abs(d[0]) + std::abs(d[1]) + std::abs(d[2]));
+}
+
+/// The frame's balls and struts along @p d, grown by @p marginMm: what a body must not meet.
+std::unique_ptr<mount::DepthRaster> frameRaster(const zome::Structure& frame,
+                                                const Transform4d& frameToGridMm, const Vec3d& d,
+                                                const Box3d& bounds, double pixelMm, double marginMm) {
+    auto r = std::make_unique<mount::DepthRaster>(mount::SweepAxes(d), bounds, pixelMm, true);
+    const zome::ZomeScale& scale = frame.scale();
+    for (zome::BallId id : frame.ballIds())
+        r->addSphere(frameToGridMm.apply(frame.ball(id).positionMm), scale.ballRadiusMm(), marginMm, id);
+    for (zome::StrutId id : frame.strutIds()) {
+        const zome::Strut& s = frame.strut(id);
+        r->addCapsule(frameToGridMm.apply(s.startMm), frameToGridMm.apply(s.endMm),
+                      scale.strutRadiusMm(s.color), marginMm, kStrutBit | id);
+    }
+    return r;
+}
+
+std::string obstacleName(uint32_t id) {
+    return (id & kStrutBit) ? "strut " + std::to_string(id & ~kStrutBit) : "ball " + std::to_string(id);
+}
+
+}  // namespace
+
+const DirectionOption* MountBody::bestFree() const {
+    for (const DirectionOption& o : options)
+        if (o.isFree && o.tenons > 0) return &o;
+    return nullptr;
+}
+
+FrameSweeps::FrameSweeps(const zome::Structure& frame, const Transform4d& frameToGridMm, const Box3d& bounds,
+                         double pixelMm, double marginMm)
+    : mFrame(&frame),
+      mFrameToGrid(frameToGridMm),
+      mBounds(bounds),
+      mPixelMm(pixelMm),
+      mMarginMm(marginMm),
+      mRasters(zome::kHoleCount),
+      mOnce(new std::once_flag[zome::kHoleCount]) {}
+
+const mount::DepthRaster& FrameSweeps::raster(int hole) const {
+    std::call_once(mOnce[size_t(hole)], [&] {
+        mRasters[size_t(hole)] = frameRaster(*mFrame, mFrameToGrid, gridDirection(hole, mFrameToGrid),
+                                             mBounds, mPixelMm, mMarginMm);
+    });
+    return *mRasters[size_t(hole)];
+}
+
+bool FrameSweeps::isFree(const MountBody& body, int hole, double voxelMm, std::string* blockedBy) const {
+    if (mBounds.isEmpty() || mFrame->ballCount() == 0) return true;
+    const mount::DepthRaster& obstacles = raster(hole);
+    // The body as a moving one: its voxels' rearmost points (a voxel's cube as seen along d).
+    mount::DepthRaster moving(obstacles, body.bounds, false, voxelMm);
+    const Vec3d& d = obstacles.axes().d;
+    const double half = halfDepth(d, voxelMm);
+    for (size_t i = 0; i < body.voxels.size(); ++i)
+        moving.addPoint(madd(body.voxels[i], -half, d), 0.0, uint32_t(i));
+    const mount::SweepHit hit = mount::worstHit(obstacles, moving, 0.0);
+    if (hit.isHit && blockedBy)
+        *blockedBy = obstacleName(hit.obstacle) + " by " + formatNumber(hit.overlapMm, 2) + " mm";
+    return !hit.isHit;
+}
+
+PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
+                          const std::vector<TenonCandidate>& candidates) {
+    const size_t n = out.pieces.size();
+    PlannerInput in;
+    in.pieces.resize(n);
+    in.candidatesByHole.resize(n);
+    for (uint32_t p = 0; p < n; ++p) in.pieces[p].pieces = {p};
+    // A body pushed along d first meets things with its rearmost points, which lie on its surface:
+    // the inside voxels with a 6-neighbour outside the wall or in another piece are enough.
+    std::vector<uint8_t> isSurface(field.phi.size(), 0), nearCut(field.phi.size(), 0);
+    forEachForwardPair(field, [&](size_t a, size_t b) {
+        const bool ia = field.isInside(a), ib = field.isInside(b);
+        const bool isCut = ia && ib && field.owner[a] != field.owner[b];
+        if (ia && (!ib || isCut)) isSurface[a] = 1;
+        if (ib && (!ia || isCut)) isSurface[b] = 1;
+        if (isCut) nearCut[a] = nearCut[b] = 2;
+    });
+    // One more layer inward from the cut faces (6-neighbours in the same piece).
+    forEachForwardPair(field, [&](size_t a, size_t b) {
+        if (!field.isInside(a) || !field.isInside(b) || field.owner[a] != field.owner[b]) return;
+        if (nearCut[a] == 2 && !nearCut[b]) nearCut[b] = 1;
+        if (nearCut[b] == 2 && !nearCut[a]) nearCut[a] = 1;
+    });
+    for (size_t s = 0; s < field.phi.size(); ++s)
+        if (isSurface[s] && field.owner[s] < n) {
+            const Vec3d x = field.world(field.coordOf(s));
+            MountBody& body = in.pieces[field.owner[s]];
+            body.voxels.push_back(x);
+            body.isNearCut.push_back(nearCut[s] ? 1 : 0);
+            body.bounds.expand(x);
+        }
+    for (const TenonCandidate& c : candidates) {
+        if (c.piece < 0 || size_t(c.piece) >= n || !c.rejection.empty()) continue;
+        auto& entry = in.candidatesByHole[size_t(c.piece)][c.tenon.hole];
+        ++entry.first;
+        entry.second += c.score;
+    }
+    return in;
+}
+
+std::vector<DirectionOption> rankedOptions(const std::map<int, std::pair<size_t, double>>& byHole,
+                                           size_t cap) {
+    std::vector<DirectionOption> options;
+    for (const auto& [hole, entry] : byHole) {
+        DirectionOption o;
+        o.hole = hole;
+        o.tenons = entry.first;
+        o.score = entry.second;
+        options.push_back(o);
+    }
+    std::stable_sort(options.begin(), options.end(), [&](const DirectionOption& a, const DirectionOption& b) {
+        const size_t ta = std::min(a.tenons, cap), tb = std::min(b.tenons, cap);
+        return ta != tb ? ta > tb : a.score > b.score;
+    });
+    return options;
+}
+
+void testPaths(MountBody& body, const FrameSweeps& sweeps, double voxelMm, bool isFirstFreeOnly) {
+    auto test = [&](DirectionOption& o) {
+        if (o.isTested) return;
+        o.isFree = sweeps.isFree(body, o.hole, voxelMm, &o.blockedBy);
+        o.isTested = true;
+    };
+    if (isFirstFreeOnly) {
+        for (DirectionOption& o : body.options) {
+            test(o);
+            if (o.isFree) return;
+        }
+        return;
+    }
+    // In parallel: the rasters are read-only.
+    tbb::parallel_for(size_t(0), body.options.size(), [&](size_t i) { test(body.options[i]); });
+}
+
+MountBody makeBody(const std::vector<uint32_t>& members, const PlannerInput& input, const FrameSweeps& sweeps,
+                   double voxelMm, int maxPerPiece, bool isFirstFreeOnly) {
+    MountBody body;
+    body.pieces = members;
+    std::sort(body.pieces.begin(), body.pieces.end());
+    std::map<int, std::pair<size_t, double>> byHole;
+    for (uint32_t p : body.pieces) {
+        const MountBody& piece = input.pieces[p];
+        body.voxels.insert(body.voxels.end(), piece.voxels.begin(), piece.voxels.end());
+        body.isNearCut.insert(body.isNearCut.end(), piece.isNearCut.begin(), piece.isNearCut.end());
+        body.bounds.expand(piece.bounds.min), body.bounds.expand(piece.bounds.max);
+        for (const auto& [hole, entry] : input.candidatesByHole[p]) {
+            byHole[hole].first += entry.first;
+            byHole[hole].second += entry.second;
+        }
+    }
+    body.options = rankedOptions(byHole, size_t(std::max(1, maxPerPiece)) * body.pieces.size());
+    testPaths(body, sweeps, voxelMm, isFirstFreeOnly);
+    return body;
+}
+
+}  // namespace zomefab::pieces::detail

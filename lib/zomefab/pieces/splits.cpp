@@ -1,0 +1,180 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Re-cutting a piece no direction can mount (detail/splits.h, docs/mounting.md).
+#include "zomefab/pieces/detail/splits.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <unordered_map>
+
+namespace zomefab::pieces::detail {
+
+namespace {
+
+/// The 13 directions of the split planes: axes, face diagonals, body diagonals (unit).
+std::vector<Vec3d> splitDirections() {
+    std::vector<Vec3d> out;
+    for (int x = -1; x <= 1; ++x)
+        for (int y = -1; y <= 1; ++y)
+            for (int z = -1; z <= 1; ++z) {
+                const Vec3d d{double(x), double(y), double(z)};
+                // One of ±d: the first non-zero component positive.
+                const bool isFirst = x > 0 || (x == 0 && (y > 0 || (y == 0 && z > 0)));
+                if (isFirst) out.push_back(normalized(d));
+            }
+    return out;
+}
+
+/// The piece's voxels with their 6-neighbours (indices, kNone where the neighbour is not in it).
+struct VoxelGraph {
+    const std::vector<Vec3d>* voxels = nullptr;
+    std::vector<std::array<uint32_t, 6>> neighbours;
+};
+
+VoxelGraph voxelGraph(const std::vector<Vec3d>& voxels, const SplitSearch& s) {
+    auto key = [&](const Vec3d& x, int dx, int dy, int dz) {
+        const int64_t i = std::llround((x[0] - s.originMm[0]) / s.voxelMm) + dx;
+        const int64_t j = std::llround((x[1] - s.originMm[1]) / s.voxelMm) + dy;
+        const int64_t k = std::llround((x[2] - s.originMm[2]) / s.voxelMm) + dz;
+        return ((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF);
+    };
+    std::unordered_map<int64_t, uint32_t> index;
+    index.reserve(voxels.size() * 2);
+    for (uint32_t v = 0; v < voxels.size(); ++v) index.emplace(key(voxels[v], 0, 0, 0), v);
+    VoxelGraph g;
+    g.voxels = &voxels;
+    g.neighbours.resize(voxels.size());
+    static const int offsets[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (uint32_t v = 0; v < voxels.size(); ++v)
+        for (int k = 0; k < 6; ++k) {
+            const auto it = index.find(key(voxels[v], offsets[k][0], offsets[k][1], offsets[k][2]));
+            g.neighbours[v][size_t(k)] = it == index.end() ? kNone : it->second;
+        }
+    return g;
+}
+
+/// Whether the voxels with @p side[v] == @p which are 6-connected (and there are some).
+bool isConnected(const VoxelGraph& g, const std::vector<uint8_t>& side, uint8_t which) {
+    uint32_t start = kNone;
+    size_t count = 0;
+    for (uint32_t v = 0; v < side.size(); ++v)
+        if (side[v] == which) {
+            if (start == kNone) start = v;
+            ++count;
+        }
+    if (count == 0) return false;
+    std::vector<uint8_t> seen(side.size(), 0);
+    std::vector<uint32_t> queue{start};
+    seen[start] = 1;
+    for (size_t q = 0; q < queue.size(); ++q)
+        for (uint32_t w : g.neighbours[queue[q]])
+            if (w != kNone && side[w] == which && !seen[w]) {
+                seen[w] = 1;
+                queue.push_back(w);
+            }
+    return queue.size() == count;
+}
+
+/// One half as a body: its surface voxels (a neighbour missing or across the cut), the candidates
+/// on its side away from the cut, its options tested along the ranking until the first free one.
+MountBody halfBody(const VoxelGraph& g, const std::vector<uint8_t>& side, uint8_t which,
+                   const std::vector<const TenonCandidate*>& candidates, const SplitPlane& plane,
+                   const FrameSweeps& sweeps, const SplitSearch& s) {
+    MountBody half;
+    for (uint32_t v = 0; v < side.size(); ++v) {
+        if (side[v] != which) continue;
+        bool isSurface = false;
+        for (uint32_t w : g.neighbours[v]) isSurface = isSurface || w == kNone || side[w] != which;
+        if (!isSurface) continue;
+        half.voxels.push_back((*g.voxels)[v]);
+        half.isNearCut.push_back(0);
+        half.bounds.expand((*g.voxels)[v]);
+    }
+    const double sign = which ? 1.0 : -1.0;
+    std::map<int, std::pair<size_t, double>> byHole;
+    for (const TenonCandidate* c : candidates) {
+        const double along = sign * (dot(plane.normal, c->tenon.pointAt(c->tenon.baseMm)) - plane.offsetMm);
+        if (along < s.edgeMarginMm) continue;
+        byHole[c->tenon.hole].first += 1;
+        byHole[c->tenon.hole].second += c->score;
+    }
+    half.options = rankedOptions(byHole, size_t(s.maxPerPiece));
+    testPaths(half, sweeps, s.voxelMm, true);
+    return half;
+}
+
+/// Tenons of the weaker half and of both, when both halves are connected, large enough and held;
+/// else (0, 0).
+std::pair<size_t, size_t> splitValue(const VoxelGraph& g,
+                                     const std::vector<const TenonCandidate*>& candidates,
+                                     const SplitPlane& plane, const FrameSweeps& sweeps,
+                                     const SplitSearch& s) {
+    const std::vector<Vec3d>& voxels = *g.voxels;
+    std::vector<uint8_t> side(voxels.size());
+    size_t above = 0;
+    for (size_t v = 0; v < voxels.size(); ++v)
+        above += side[v] = dot(plane.normal, voxels[v]) > plane.offsetMm;
+    const double voxelVolume = s.voxelMm * s.voxelMm * s.voxelMm;
+    if (double(std::min(above, voxels.size() - above)) * voxelVolume < s.minVolumeMm3) return {0, 0};
+    if (!isConnected(g, side, 0) || !isConnected(g, side, 1)) return {0, 0};
+    const MountBody a = halfBody(g, side, 0, candidates, plane, sweeps, s);
+    const DirectionOption* oa = a.bestFree();
+    if (!oa) return {0, 0};
+    const MountBody b = halfBody(g, side, 1, candidates, plane, sweeps, s);
+    const DirectionOption* ob = b.bestFree();
+    if (!ob) return {0, 0};
+    const size_t cap = size_t(s.maxPerPiece);
+    const size_t ta = std::min(oa->tenons, cap), tb = std::min(ob->tenons, cap);
+    return {std::min(ta, tb), ta + tb};
+}
+
+}  // namespace
+
+std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
+                                    const std::vector<const TenonCandidate*>& candidates,
+                                    const FrameSweeps& sweeps, const SplitSearch& search) {
+    if (voxels.size() < 2) return std::nullopt;
+    const VoxelGraph graph = voxelGraph(voxels, search);
+    std::optional<SplitPlane> best;
+    std::pair<size_t, size_t> bestValue{0, 0};
+    for (const double quantile : {0.5, 1.0 / 3.0, 2.0 / 3.0}) {
+        for (const Vec3d& n : splitDirections()) {
+            std::vector<double> along;
+            along.reserve(voxels.size());
+            for (const Vec3d& x : voxels) along.push_back(dot(n, x));
+            const size_t k = size_t(quantile * double(along.size() - 1));
+            std::nth_element(along.begin(), along.begin() + std::ptrdiff_t(k), along.end());
+            // Halfway between voxel centres, so no voxel lies on the plane.
+            const double offset = (std::floor(along[k] / search.voxelMm) + 0.5) * search.voxelMm;
+            const SplitPlane plane{n, offset};
+            const std::pair<size_t, size_t> value = splitValue(graph, candidates, plane, sweeps, search);
+            if (value.first > 0 && value > bestValue) best = plane, bestValue = value;
+        }
+        if (best) return best;  // the median planes first: halves of similar size
+    }
+    return best;
+}
+
+uint32_t splitPiece(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field, uint32_t p,
+                    const SplitPlane& plane) {
+    const uint32_t q = uint32_t(pieces.size());
+    Piece half;
+    half.id = q;
+    half.cells = pieces[p].cells;
+    half.requests = pieces[p].requests;
+    pieces.push_back(half);
+    CellSet other = sets[p];
+    sets[p].halfSpaces.push_back({plane.normal, plane.offsetMm});
+    other.halfSpaces.push_back({scale(plane.normal, -1.0), -plane.offsetMm});
+    sets.push_back(other);
+    const double voxelVolume = field.voxelMm * field.voxelMm * field.voxelMm;
+    pieces[p].shellVolumeMm3 = 0.0;
+    for (size_t s = 0; s < field.phi.size(); ++s) {
+        if (!field.isActive[s] || field.owner[s] != p) continue;
+        if (dot(plane.normal, field.world(field.coordOf(s))) > plane.offsetMm) field.owner[s] = q;
+        if (field.isInside(s)) (field.owner[s] == q ? pieces[q] : pieces[p]).shellVolumeMm3 += voxelVolume;
+    }
+    return q;
+}
+
+}  // namespace zomefab::pieces::detail
