@@ -90,35 +90,44 @@ TEST_CASE("assembly_guide: colours, sizes and separate components") {
     CHECK(g.steps[2].struts.size() == 4);
     const std::string md = assemblyGuideMarkdown(g);
     CHECK(md.find("## Frame part 2") != std::string::npos);
-    CHECK(md.find("Y0 (yellow) in hole 30") != std::string::npos);
-    CHECK(md.find("R0 (red) in hole 50") != std::string::npos);
-    CHECK(md.find("B1 (blue) in hole 2 (+0.00, +0.00, +1.00)") != std::string::npos);
+    CHECK(md.find("Y0 (yellow) in the yellow hole pointing") != std::string::npos);
+    CHECK(md.find("(30)") != std::string::npos);
+    CHECK(md.find("R0 (red) in the red hole pointing") != std::string::npos);
+    CHECK(md.find("B1 (blue) in the blue hole pointing straight up (2)") != std::string::npos);
 }
 
-TEST_CASE("assembly_guide: tenons per piece, in order, and their checks") {
+TEST_CASE("assembly_guide: the mounting steps, in order, and their checks") {
     const zome::Structure cube = cubeFrame();
     // Ball 0 uses the blue holes towards +x, +y, +z (0, 1, 2); the −z hole (17) is free.
-    const std::vector<TenonLink> tenons = {{"piece-01", 0, 17}, {"piece-00", 1, 17}, {"piece-01", 2, 17}};
-    const AssemblyGuide g = assemblyGuide(cube, tenons, {"piece-00", "piece-01", "piece-02"});
-    REQUIRE(g.pieces.size() == 3);
-    CHECK(g.pieces[0].piece == "piece-00");
-    CHECK(g.pieces[0].tenons.size() == 1);
-    CHECK(g.pieces[1].tenons.size() == 2);
-    CHECK(g.pieces[1].tenons[1].ball == 2);
-    CHECK(g.pieces[2].tenons.empty());
+    std::vector<MountingStep> steps(2);
+    steps[0].pieces = {"piece-01"};
+    steps[0].hole = 17;
+    steps[0].tenons = {{"piece-01", 0, 17}, {"piece-01", 2, 17}};
+    steps[1].pieces = {"piece-00", "piece-02"};
+    steps[1].glue = {{"piece-00", "piece-02", 2}};
+    steps[1].hole = 17;
+    steps[1].tenons = {{"piece-00", 1, 17}};
+    const AssemblyGuide g = assemblyGuide(cube, steps);
+    REQUIRE(g.mounting.size() == 2);
     const std::string md = assemblyGuideMarkdown(g);
-    CHECK(md.find("| piece-01 | ball-0 hole 17, ball-2 hole 17 |") != std::string::npos);
-    CHECK(md.find("| piece-02 | none") != std::string::npos);
+    CHECK(md.find("### Step 1: piece-01") != std::string::npos);
+    CHECK(md.find("Approach from: straight down. Push: straight up") != std::string::npos);
+    CHECK(md.find("the blue hole pointing straight down (17) of ball-0, ball-2.") != std::string::npos);
+    CHECK(md.find("### Step 2: piece-00 + piece-02") != std::string::npos);
+    CHECK(md.find("First glue piece-00 to piece-02 along their common cut face (2 alignment pins)") !=
+          std::string::npos);
     CHECK(md.find("Blue") != std::string::npos);  // the parts table
     const nlohmann::json j = assemblyGuideToJson(g);
     CHECK(j["steps"].size() == 8);
-    CHECK(j["pieces"][1]["tenons"][1]["ball"] == 2);
+    CHECK(j["mounting"][0]["pegs"][1]["ball"] == 2);
+    CHECK(j["mounting"][1]["glue"][0]["pins"] == 2);
+    CHECK(j["mounting"][0]["push"] == nlohmann::json::array({0.0, 0.0, 1.0}));
     CHECK(j["start_balls"] == nlohmann::json::array({0}));
 
-    auto fails = [&](const TenonLink& t, const std::string& expected) {
+    auto fails = [&](const MountingStep& step, const std::string& expected) {
         bool thrown = false;
         try {
-            assemblyGuide(cube, {t});
+            assemblyGuide(cube, {step});
         } catch (const Error& e) {
             thrown = true;
             CHECK(e.code() == ErrorCode::InvalidInput);
@@ -126,9 +135,18 @@ TEST_CASE("assembly_guide: tenons per piece, in order, and their checks") {
         }
         CHECK(thrown);
     };
-    fails({"piece-07", 99, 3}, "piece-07: tenon into hole 3 of ball-99: no such ball");
-    fails({"piece-07", 0, 62}, "holes are numbered 0..61");
-    fails({"piece-07", 0, 0}, "the hole holds strut");
+    MountingStep bad;
+    bad.pieces = {"piece-07"};
+    bad.hole = 3;
+    bad.tenons = {{"piece-07", 99, 3}};
+    fails(bad, "piece-07: peg into hole 3 of ball-99: no such ball");
+    bad.tenons = {{"piece-07", 0, 5}};
+    fails(bad, "not along its step's direction");
+    bad.hole = 0;
+    bad.tenons = {{"piece-07", 0, 0}};
+    fails(bad, "the hole holds strut");
+    bad.hole = -1;
+    fails(bad, "has no direction");
 }
 
 TEST_CASE("assembly_guide: same frame, same text") {

@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 
+#include "zomefab/pieces/detail/pins.h"
 #include "zomefab/pieces/detail/stages.h"
 #include "zomefab/sdf/level_set.h"
 
@@ -108,6 +109,30 @@ void addTenons(FloatGrid& grid, openvdb::BoolTree& mask, const VoxelField& field
     }
 }
 
+/// Alignment pins: a pin unioned (ψ = min(ψ, pin)), a socket cut (ψ = max(ψ, −socket)).
+void addPins(FloatGrid& grid, openvdb::BoolTree& mask, const VoxelField& field, const Piece& piece,
+             const PinOptions& o) {
+    const float bg = field.background;
+    FloatGrid::Accessor acc = grid.getAccessor();
+    for (const AlignmentPin& pin : piece.pins) {
+        const openvdb::CoordBBox box = indexBox(field, pinBoundsMm(pin, o.clearanceMm));
+        mask.fill(box, true, true);
+        for (auto it = box.begin(); it; ++it) {
+            const Coord ijk = *it;
+            const double d = pinSignedDistanceMm(pin, o.clearanceMm, field.world(ijk));
+            const float old = acc.getValue(ijk);
+            const double value = pin.isSocket ? std::max(double(old), -d) : std::min(double(old), d);
+            if (value == double(old)) continue;
+            if (value >= bg)
+                acc.setValueOff(ijk, bg);
+            else if (value <= -bg)
+                acc.setValueOff(ijk, -bg);
+            else
+                acc.setValueOn(ijk, float(value));
+        }
+    }
+}
+
 /// The engraved number: difference, ψ = max(ψ, −glyph).
 void engraveLabel(FloatGrid& grid, openvdb::BoolTree& mask, const VoxelField& field, const PieceLabel& label,
                   const LabelOptions& o) {
@@ -191,6 +216,7 @@ PieceGrid pieceGrid(const VoxelField& field, const GridCells& cells, const std::
     markSeams(*mask, field, piece.id, leaves);
     openvdb::tools::dilateActiveValues(*mask, 1);
     addTenons(*out.grid, *mask, field, piece, options.tenons);
+    addPins(*out.grid, *mask, field, piece, options.pins);
     if (piece.label) engraveLabel(*out.grid, *mask, field, *piece.label, options.label);
     openvdb::tools::pruneLevelSet(out.grid->tree());
     if (!mask->empty()) {

@@ -37,6 +37,25 @@ struct MountOptions {
     double frameMarginMm = 1.0;
 };
 
+/// Where two pieces glued before mounting meet: a printed pin on one, a socket in the other, across
+/// their common cut face, so the two are glued in the one position they were cut in.
+struct AlignmentPin {
+    uint32_t partner = 0;         ///< the other piece of the pair
+    bool isSocket = false;        ///< this piece has the hole; the partner has the pin
+    Vec3d centerGridMm{0, 0, 0};  ///< on the cut face's plane (grid mm)
+    Vec3d axisGrid{0, 0, 1};      ///< unit, out of the piece with the pin, into the one with the socket
+    double radiusMm = 1.5;        ///< the pin's; the socket is this plus the clearance
+    double lengthMm = 3.0;        ///< how far the pin stands out of its face
+};
+
+/// How glued pairs are pinned together (docs/mounting.md, "Glued groups").
+struct PinOptions {
+    double diameterMm = 3.0;    ///< the pin; less where the wall is thinner (never under 1.5)
+    double lengthMm = 3.0;      ///< standing out of the face; the socket is 0.3 mm deeper
+    double clearanceMm = 0.15;  ///< between pin and socket on every side
+    int perPair = 2;            ///< pins per glued pair, as far apart as the face allows
+};
+
 struct PiecesOptions {
     /// Connected pieces with less volume are merged into the neighbour they share the largest cut
     /// face with (a 2 cm³ sliver is too small to carry a tenon or to print well). Never dropped:
@@ -45,6 +64,7 @@ struct PiecesOptions {
     TenonOptions tenons;
     LabelOptions label;
     MountOptions mount;
+    PinOptions pins;
     /// Every cut face is moved this far into its piece (mm), so neighbours meet with twice this
     /// gap: room for glue and for the printer's few tenths, and where three cells meet the two
     /// meshes' voxel rounding does not make them overlap.
@@ -75,6 +95,9 @@ struct Piece {
     /// When fewer than TenonOptions::minPerPiece tenons were found: why each candidate ray failed
     /// ("hole holds a strut" → 3, ...); empty otherwise.
     std::map<std::string, int> tenonShortfall;
+
+    /// Pins and sockets toward the pieces it is glued to (the plan's glued pairs).
+    std::vector<AlignmentPin> pins;
 
     std::optional<PieceLabel> label;  ///< the engraved number, when there was room
     std::string labelNote;            ///< why there is no label

@@ -83,6 +83,12 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                       {"embed_mm", o.tenons.embedMm},
                       {"frame_clearance_mm", o.tenons.frameClearanceMm},
                       {"holes", tenonHolesName(o.tenons.holes)}}},
+                    {"seam_gap_mm", o.seamGapMm},
+                    {"pins",
+                     {{"diameter_mm", o.pins.diameterMm},
+                      {"length_mm", o.pins.lengthMm},
+                      {"clearance_mm", o.pins.clearanceMm},
+                      {"per_pair", o.pins.perPair}}},
                     {"label",
                      {{"enabled", o.label.isEnabled},
                       {"height_mm", o.label.heightMm},
@@ -115,6 +121,14 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                               {"length_mm", t.lengthMm()},
                               {"tilt_deg", t.tiltDeg}});
         }
+        json pins = json::array();
+        for (const AlignmentPin& pin : p.pins)
+            pins.push_back({{"partner", pin.partner},
+                            {"kind", pin.isSocket ? "socket" : "pin"},
+                            {"center_mm", toJson(pin.centerGridMm)},
+                            {"axis", toJson(pin.axisGrid)},
+                            {"radius_mm", pin.radiusMm},
+                            {"length_mm", pin.lengthMm}});
         json shortfall = nullptr;
         if (p.tenons.size() < size_t(o.tenons.minPerPiece)) {
             shortfall = {
@@ -150,6 +164,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                           {"slivers_merged", p.sliversMerged},
                           {"tenons", tenons},
                           {"tenon_shortfall", shortfall},
+                          {"pins", pins},
                           {"label", label},
                           {"label_note", p.label ? json(nullptr) : json(p.labelNote)}});
     }

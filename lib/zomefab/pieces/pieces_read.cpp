@@ -155,6 +155,20 @@ Piece pieceFromJson(const json& j, size_t index, const std::string& directory) {
     }
     if (j.contains("label_note") && j["label_note"].is_string())
         piece.labelNote = j["label_note"].get<std::string>();
+    for (const json& pin : j.value("pins", json::array())) {
+        const std::string w = what + ".pins";
+        AlignmentPin a;
+        a.partner = indexFromJson(requireMember(pin, "partner", w), w + ".partner");
+        const std::string kind =
+            requireMember(pin, "kind", w).is_string() ? pin["kind"].get<std::string>() : "";
+        if (kind != "pin" && kind != "socket") fail(w + ".kind must be \"pin\" or \"socket\"");
+        a.isSocket = kind == "socket";
+        a.centerGridMm = vec3FromJson(requireMember(pin, "center_mm", w), w + ".center_mm");
+        a.axisGrid = vec3FromJson(requireMember(pin, "axis", w), w + ".axis");
+        a.radiusMm = numberFromJson(requireMember(pin, "radius_mm", w), w + ".radius_mm");
+        a.lengthMm = numberFromJson(requireMember(pin, "length_mm", w), w + ".length_mm");
+        piece.pins.push_back(a);
+    }
     const json& direction = j.value("direction", json());
     if (direction.is_object()) {
         piece.hole = intFromJson(requireMember(direction, "hole", what), what + ".direction.hole");

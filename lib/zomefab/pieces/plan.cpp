@@ -9,6 +9,7 @@
 #include "zomefab/core/format.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/pieces/detail/mounting.h"
+#include "zomefab/pieces/detail/pins.h"
 #include "zomefab/pieces/detail/splits.h"
 #include "zomefab/pieces/detail/stages.h"
 
@@ -115,6 +116,11 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
                       " s");
         if (cut == 0) break;
     }
+    const size_t unpinned = placePins(out, field, cells, grouping.cellSets, opt);
+    if (unpinned > 0)
+        context.warn(std::to_string(unpinned) + " of " + std::to_string(out.plan.glued.size()) +
+                     " glued pairs have fewer than " + std::to_string(opt.pins.perPair) +
+                     " alignment pins (the face has no room): line them up by eye when gluing");
     TenonPlan plan = chooseTenons(candidates, out.plan.holeOfPiece, opt.tenons);
     for (size_t p = 0; p < out.pieces.size(); ++p) {
         out.pieces[p].hole = out.plan.holeOfPiece[p];

@@ -7,6 +7,7 @@
 
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
+#include "zomefab/core/vec.h"
 #include "zomefab/core/version.h"
 
 namespace zomefab::report {
@@ -24,10 +25,37 @@ bool lowerThan(const zome::Structure& frame, zome::BallId a, zome::BallId b) {
 
 std::string ballName(zome::BallId id) { return "ball-" + std::to_string(id); }
 
+/// The plan's steps checked against the frame.
+void checkMounting(const zome::Structure& frame, const std::vector<MountingStep>& mounting) {
+    for (size_t s = 0; s < mounting.size(); ++s) {
+        const MountingStep& step = mounting[s];
+        const std::string who = step.pieces.empty() ? "step " + std::to_string(s + 1) : step.pieces[0];
+        if (step.hole < 0 || step.hole >= zome::kHoleCount)
+            throw Error(ErrorCode::InvalidInput, who + ": the mounting step has no direction (hole 0..61)");
+        for (const TenonLink& t : step.tenons) {
+            const std::string where =
+                t.piece + ": peg into hole " + std::to_string(t.hole) + " of " + ballName(t.ball);
+            if (t.hole != step.hole)
+                throw Error(ErrorCode::InvalidInput, where + ": not along its step's direction");
+            if (!frame.hasBall(t.ball))
+                throw Error(ErrorCode::InvalidInput, where + ": no such ball in the frame");
+            if (!frame.isHoleFree(t.ball, t.hole))
+                throw Error(ErrorCode::InvalidInput,
+                            where + ": the hole holds strut " +
+                                std::to_string(frame.ball(t.ball).holes[size_t(t.hole)]));
+        }
+    }
+}
+
+/// "the blue hole pointing straight up": a hole as a builder sees it.
+std::string holeWords(int hole) {
+    return std::string("the ") + zome::colorName(zome::holeColor(hole)) + " hole pointing " +
+           zome::directionName(zome::holeDirection(hole));
+}
+
 }  // namespace
 
-AssemblyGuide assemblyGuide(const zome::Structure& frame, const std::vector<TenonLink>& tenons,
-                            const std::vector<std::string>& pieceOrder) {
+AssemblyGuide assemblyGuide(const zome::Structure& frame, const std::vector<MountingStep>& mounting) {
     AssemblyGuide guide;
     guide.parts = zome::partsList(frame);
     const std::vector<zome::BallId> ids = frame.ballIds();
@@ -85,30 +113,45 @@ AssemblyGuide assemblyGuide(const zome::Structure& frame, const std::vector<Teno
         }
     }
 
-    std::map<std::string, size_t> pieceIndex;
-    auto pieceSlot = [&](const std::string& name) {
-        const auto it = pieceIndex.find(name);
-        if (it != pieceIndex.end()) return it->second;
-        guide.pieces.push_back({name, {}});
-        pieceIndex.emplace(name, guide.pieces.size() - 1);
-        return guide.pieces.size() - 1;
-    };
-    for (const std::string& name : pieceOrder) pieceSlot(name);
-    for (const TenonLink& t : tenons) {
-        const std::string where =
-            t.piece + ": tenon into hole " + std::to_string(t.hole) + " of " + ballName(t.ball);
-        if (!frame.hasBall(t.ball))
-            throw Error(ErrorCode::InvalidInput, where + ": no such ball in the frame");
-        if (t.hole < 0 || t.hole >= zome::kHoleCount)
-            throw Error(ErrorCode::InvalidInput, where + ": holes are numbered 0..61");
-        if (!frame.isHoleFree(t.ball, t.hole))
-            throw Error(
-                ErrorCode::InvalidInput,
-                where + ": the hole holds strut " + std::to_string(frame.ball(t.ball).holes[size_t(t.hole)]));
-        guide.pieces[pieceSlot(t.piece)].tenons.push_back(t);
-    }
+    checkMounting(frame, mounting);
+    guide.mounting = mounting;
     return guide;
 }
+
+namespace {
+
+std::string mountingMarkdown(const std::vector<MountingStep>& mounting) {
+    std::string md =
+        "\n## Putting the pieces on\n\nWith the frame built, put the printed pieces on one at a time, in "
+        "this "
+        "order. Each goes on along one direction, all its pegs at once: hold it on the side it approaches "
+        "from, "
+        "pegs toward the frame, line every peg up with its hole and push it straight in until the pegs are "
+        "seated (4 mm). "
+        "Glue a group's pieces together first, pins into sockets, and let the glue set.\n";
+    for (size_t s = 0; s < mounting.size(); ++s) {
+        const MountingStep& step = mounting[s];
+        std::string names;
+        for (const std::string& p : step.pieces) names += (names.empty() ? "" : " + ") + p;
+        const Vec3d& d = zome::holeDirection(step.hole);
+        md += "\n### Step " + std::to_string(s + 1) + ": " + names + "\n\n";
+        for (const GlueJoint& g : step.glue)
+            md += "- First glue " + g.a + " to " + g.b + " along their common cut face (" +
+                  std::to_string(g.pins) + " alignment pin" + (g.pins == 1 ? "" : "s") + ").\n";
+        md += "- Approach from: " + zome::directionName(d) +
+              ". Push: " + zome::directionName(scale(d, -1.0)) +
+              formatNumbers(" (direction %+.3f, %+.3f, %+.3f).\n", 0.0 - d[0], 0.0 - d[1], 0.0 - d[2]);
+        md += "- Its pegs go into " + holeWords(step.hole) + " (" + std::to_string(step.hole) + ") of ";
+        if (step.tenons.empty()) md += "no ball: it is held by the pieces it is glued to";
+        for (size_t i = 0; i < step.tenons.size(); ++i)
+            md += (i ? ", " : "") + ballName(step.tenons[i].ball) +
+                  (step.pieces.size() > 1 ? " (" + step.tenons[i].piece + ")" : "");
+        md += ".\n";
+    }
+    return md;
+}
+
+}  // namespace
 
 std::string assemblyGuideMarkdown(const AssemblyGuide& guide, const zome::PriceOptions& prices) {
     std::string md = "# Assembly guide\n\n";
@@ -119,14 +162,13 @@ std::string assemblyGuideMarkdown(const AssemblyGuide& guide, const zome::PriceO
     md += ".\n\n";
     md +=
         "Build the frame ball by ball in the order below: breadth-first from the lowest ball, one layer of "
-        "balls at a "
-        "time, each layer from the bottom up. At each ball, attach the struts listed (the ones not attached "
-        "yet); "
-        "\"new\" means the strut carries a ball that is not in place yet: put a new ball on its free end. "
-        "Positions "
-        "are in millimetres, z up. Hole numbers are zomefab's (blue 0-29, yellow 30-49, red 50-61); the "
-        "direction "
-        "after each hole is the unit vector from the ball's centre through that hole.\n\n";
+        "balls at a time, each layer from the bottom up. At each ball, attach the struts listed (the ones "
+        "not "
+        "attached yet); \"new\" means the strut carries a ball that is not in place yet: put a new ball on "
+        "its free end. Positions are in millimetres; directions are as you face the model: x to the right, "
+        "y away from you, z up. Every ball sits the same way round, so a hole that points straight up on one "
+        "ball points straight up on all of them. The number after a hole is zomefab's (blue 0-29, yellow "
+        "30-49, red 50-61).\n\n";
     md += "## Parts list\n\n```text\n" + zome::partsTable(guide.parts, prices) + "```\n\n";
     md += "## Frame\n";
     size_t component = size_t(-1), layer = size_t(-1);
@@ -141,29 +183,15 @@ std::string assemblyGuideMarkdown(const AssemblyGuide& guide, const zome::PriceO
             md += "\n### Layer " + std::to_string(layer) + "\n";
         }
         md += "\n**" + ballName(step.ball) + "** at " +
-              formatNumbers("(%.1f, %.1f, %.1f) mm", step.positionMm[0], step.positionMm[1], step.positionMm[2]) +
+              formatNumbers("(%.1f, %.1f, %.1f) mm", step.positionMm[0], step.positionMm[1],
+                            step.positionMm[2]) +
               (step.struts.empty() ? ": nothing new to attach\n" : "\n");
-        for (const StrutStep& s : step.struts) {
-            const Vec3d& d = zome::holeDirection(s.hole);
-            md += "- " + zome::partName(s.color, s.size) + " (" + zome::colorName(s.color) + ") in hole " +
-                  std::to_string(s.hole) + formatNumbers(" (%+.2f, %+.2f, %+.2f)", d[0], d[1], d[2]) + " to " +
-                  ballName(s.toBall) + (s.isNewBall ? " (new)" : "") + ", its hole " +
-                  std::to_string(s.toHole) + "\n";
-        }
+        for (const StrutStep& s : step.struts)
+            md += "- " + zome::partName(s.color, s.size) + " (" + zome::colorName(s.color) + ") in " +
+                  holeWords(s.hole) + " (" + std::to_string(s.hole) + ") to " + ballName(s.toBall) +
+                  (s.isNewBall ? " (new)" : "") + ", its hole " + std::to_string(s.toHole) + "\n";
     }
-    if (!guide.pieces.empty()) {
-        md +=
-            "\n## Pieces\n\nPlug each printed piece onto the frame: its tenons go into these free holes.\n\n";
-        md += "| piece | tenons (ball, hole) |\n|---|---|\n";
-        for (const PieceStep& p : guide.pieces) {
-            md += "| " + p.piece + " | ";
-            if (p.tenons.empty()) md += "none (held by its neighbours)";
-            for (size_t i = 0; i < p.tenons.size(); ++i)
-                md += (i ? ", " : "") + ballName(p.tenons[i].ball) + " hole " +
-                      std::to_string(p.tenons[i].hole);
-            md += " |\n";
-        }
-    }
+    if (!guide.mounting.empty()) md += mountingMarkdown(guide.mounting);
     return md;
 }
 
@@ -186,17 +214,29 @@ nlohmann::json assemblyGuideToJson(const AssemblyGuide& guide) {
                          {"component", b.component},
                          {"struts", std::move(struts)}});
     }
-    nlohmann::json pieces = nlohmann::json::array();
-    for (const PieceStep& p : guide.pieces) {
-        nlohmann::json t = nlohmann::json::array();
-        for (const TenonLink& l : p.tenons) t.push_back({{"ball", l.ball}, {"hole", l.hole}});
-        pieces.push_back({{"piece", p.piece}, {"tenons", std::move(t)}});
+    nlohmann::json mounting = nlohmann::json::array();
+    for (size_t k = 0; k < guide.mounting.size(); ++k) {
+        const MountingStep& m = guide.mounting[k];
+        nlohmann::json pegs = nlohmann::json::array(), glue = nlohmann::json::array();
+        for (const TenonLink& l : m.tenons)
+            pegs.push_back({{"piece", l.piece}, {"ball", l.ball}, {"hole", l.hole}});
+        for (const GlueJoint& g : m.glue) glue.push_back({{"pieces", {g.a, g.b}}, {"pins", g.pins}});
+        const Vec3d& d = zome::holeDirection(m.hole);
+        mounting.push_back({{"step", k + 1},
+                            {"pieces", m.pieces},
+                            {"glue", std::move(glue)},
+                            {"hole", m.hole},
+                            {"hole_color", zome::colorName(zome::holeColor(m.hole))},
+                            {"from", zome::directionName(d)},
+                            {"push", {0.0 - d[0], 0.0 - d[1], 0.0 - d[2]}},
+                            {"push_name", zome::directionName(scale(d, -1.0))},
+                            {"pegs", std::move(pegs)}});
     }
     return {{"start_balls", std::move(starts)},
             {"layers", guide.layers},
             {"components", guide.components},
             {"steps", std::move(steps)},
-            {"pieces", std::move(pieces)}};
+            {"mounting", std::move(mounting)}};
 }
 
 }  // namespace zomefab::report

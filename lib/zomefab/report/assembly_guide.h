@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /// @file The assembly guide (`assembly.md`): the paper's "highlight the connected struts for each
 /// ball" (§7.3) as a step list in build order, breadth-first from the lowest ball, layer by layer;
-/// then, for each printed piece, the balls its tenons plug into (§6.1). Order rules: docs/report.md.
+/// then the installation plan: in its order, each printed piece (or glued group) with the
+/// direction it is pushed on along and the ball and hole each of its pegs goes into (§6.1,
+/// docs/mounting.md). Order rules: docs/report.md.
 #pragma once
 
 #include <cstddef>
@@ -9,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "zomefab/zome/holes.h"
 #include "zomefab/zome/parts.h"
 #include "zomefab/zome/structure.h"
 
@@ -41,38 +44,44 @@ struct BallStep {
     std::vector<StrutStep> struts;  ///< sorted by colour, size, hole
 };
 
-/// The balls one piece plugs into.
-struct PieceStep {
-    std::string piece;
-    std::vector<TenonLink> tenons;  ///< in input order
+/// Two pieces glued together before their group is mounted, with the pins that line them up.
+struct GlueJoint {
+    std::string a, b;  ///< piece names
+    size_t pins = 0;
+};
+
+/// One step of the installation plan: a piece, or a group glued first, pushed onto the frame along
+/// −d, d the direction of @p hole; its pegs go into the holes @p hole of the balls listed.
+struct MountingStep {
+    std::vector<std::string> pieces;  ///< one piece, or a glued group
+    std::vector<GlueJoint> glue;      ///< how the group is glued (empty for one piece)
+    int hole = -1;                    ///< the direction, 0..61
+    std::vector<TenonLink> tenons;    ///< every peg of the step, by piece in step order
 };
 
 struct AssemblyGuide {
     zome::PartsList parts;
-    std::vector<BallStep> steps;    ///< every live ball exactly once, in build order
-    size_t layers = 0;              ///< number of layers of the largest component
-    size_t components = 0;          ///< connected components of the frame
-    std::vector<PieceStep> pieces;  ///< pieces in order of first appearance in the tenon list
+    std::vector<BallStep> steps;         ///< every live ball exactly once, in build order
+    size_t layers = 0;                   ///< number of layers of the largest component
+    size_t components = 0;               ///< connected components of the frame
+    std::vector<MountingStep> mounting;  ///< the installation plan, in order
 };
 
 /// The build order: start at the lowest ball (smallest z, then y, x, id); layer k+1 = the balls
 /// first reached from layer k; within a layer by (z, y, x, id), so each layer goes bottom up. At
 /// each ball, every strut not attached before is listed once. A frame in several pieces gets one
-/// such walk per component, lowest component first.
-/// @param tenons (piece, ball, hole) triples; @p pieceOrder optionally lists every piece name, so
-///   pieces without tenons appear too (with none)
-/// @throw Error(InvalidInput) naming the piece for a tenon into an unknown ball, a hole outside
-///   0..61 or a hole that holds a strut.
-AssemblyGuide assemblyGuide(const zome::Structure& frame, const std::vector<TenonLink>& tenons = {},
-                            const std::vector<std::string>& pieceOrder = {});
+/// such walk per component, lowest component first. @p mounting is the installation plan as it is.
+/// @throw Error(InvalidInput) naming the piece for a step without a direction, a peg along
+///   another direction, into an unknown ball, or into a hole that holds a strut.
+AssemblyGuide assemblyGuide(const zome::Structure& frame, const std::vector<MountingStep>& mounting = {});
 
 /// `assembly.md`: the parts list (zome::partsTable, paper Table 2 layout), the layers with each
-/// ball's id, position in mm and the struts to attach (part, hole and its direction, the ball it
-/// leads to), and the pieces' tenons.
+/// ball's id, position in mm and the struts to attach (part, the hole by its colour and direction
+/// in words, the ball it leads to), and the mounting steps.
 std::string assemblyGuideMarkdown(const AssemblyGuide& guide, const zome::PriceOptions& prices = {});
 
 /// The same as JSON ({"start_balls", "layers", "steps": [{"ball", "mm", "layer", "struts": [...]}],
-/// "pieces": [...]}) for report.json.
+/// "mounting": [{"step", "pieces", "glue", "hole", "direction", ...}]}) for report.json.
 nlohmann::json assemblyGuideToJson(const AssemblyGuide& guide);
 
 }  // namespace zomefab::report

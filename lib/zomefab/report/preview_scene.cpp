@@ -200,6 +200,7 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
             GlbNode node;
             node.name = name;
             node.mesh = int(scene.meshes.size() - 1);
+            if (i < input.pieceExtras.size()) node.extras = input.pieceExtras[i];
             scene.nodes.push_back(node);
             scene.nodes[size_t(group)].children.push_back(int(scene.nodes.size() - 1));
             pieceNames.push_back(name);

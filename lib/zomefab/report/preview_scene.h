@@ -24,6 +24,9 @@ struct PreviewInput {
     /// piece taking it there, e.g. printer → frame mm: affineInverse(frameToGridMm) ·
     /// affineInverse(piece.gridToPrintMm) for pieces in their print orientation.
     std::vector<Transform4d> pieceTransforms;
+    /// Empty, or one object per piece for its node's extras (the mounting step, so a viewer can
+    /// play the installation plan: docs/preview.md).
+    std::vector<nlohmann::json> pieceExtras;
     const zome::Structure* frame = nullptr;  ///< the Zometool frame; null = pieces only
     /// Merged into scenes[0].extras next to the parts list (e.g. the run's summary); null = none.
     nlohmann::json extras;

@@ -103,20 +103,33 @@ json costJson(const RunRecord& run) {
 
 }  // namespace
 
+std::vector<MountingStep> mountingSteps(const pieces::Pieces& all) {
+    std::vector<MountingStep> steps;
+    for (const mount::MountStep& plan : all.plan.steps) {
+        MountingStep step;
+        step.hole = plan.hole;
+        for (uint32_t p : plan.pieces) {
+            step.pieces.push_back(pieces::pieceName(all, p));
+            for (const pieces::Tenon& t : all.pieces[p].tenons)
+                step.tenons.push_back({step.pieces.back(), t.ball, t.hole});
+        }
+        for (const auto& [a, b] : all.plan.glued) {
+            if (std::find(plan.pieces.begin(), plan.pieces.end(), a) == plan.pieces.end()) continue;
+            size_t pins = 0;
+            for (const pieces::AlignmentPin& pin : all.pieces[a].pins) pins += pin.partner == b ? 1 : 0;
+            step.glue.push_back({pieces::pieceName(all, a), pieces::pieceName(all, b), pins});
+        }
+        steps.push_back(std::move(step));
+    }
+    return steps;
+}
+
 RunReports reportStage(const zome::Structure& frame, const pieces::Pieces& all, const TriMesh& objectMm,
                        const Fabrication& fabrication, const CostOptions& options, RunContext& context) {
-    std::vector<TenonLink> links;
-    std::vector<std::string> names;
     std::vector<const TriMesh*> printed;
-    for (size_t i = 0; i < all.pieces.size(); ++i) {
-        const pieces::Piece& piece = all.pieces[i];
-        names.push_back(pieces::pieceName(all, i));
-        printed.push_back(&piece.mesh);
-        for (const pieces::Tenon& tenon : piece.tenons)
-            links.push_back({names.back(), tenon.ball, tenon.hole});
-    }
+    for (const pieces::Piece& piece : all.pieces) printed.push_back(&piece.mesh);
     RunReports reports;
-    reports.assembly = assemblyGuide(frame, links, names);
+    reports.assembly = assemblyGuide(frame, mountingSteps(all));
     reports.cost = costReport(objectMm, printed, zome::partsList(frame), fabrication, options, context);
     return reports;
 }
@@ -141,8 +154,10 @@ json runReportJson(const RunRecord& run, const RunContext& context) {
     report["frame"] = frameJson(run);
     report["partition"] = partitionJson(run);
     report["pieces"] = piecesJson(run);
-    report["assembly"] = {
-        {"layers", run.assembly.layers}, {"components", run.assembly.components}, {"file", "assembly.md"}};
+    report["assembly"] = {{"layers", run.assembly.layers},
+                          {"components", run.assembly.components},
+                          {"mounting", assemblyGuideToJson(run.assembly)["mounting"]},
+                          {"file", "assembly.md"}};
     report["cost"] = costJson(run);
     json timings = json::array();
     for (const StageTiming& t : run.timings) timings.push_back({{"stage", t.stage}, {"seconds", t.seconds}});
@@ -172,6 +187,20 @@ PreviewInput previewInput(const pieces::Pieces& all, const zome::Structure& fram
         input.pieces.push_back(&piece.mesh);
         input.pieceNames.push_back(pieces::pieceName(all, i));
         input.pieceTransforms.push_back(gridToFrameMm * affineInverse(piece.gridToPrintMm));
+        const int step = all.plan.stepOf(uint32_t(i));
+        json extras = {{"step", step < 0 ? json(nullptr) : json(step + 1)}};
+        if (piece.hole >= 0) {
+            const Vec3d& d = zome::holeDirection(piece.hole);
+            extras["hole"] = piece.hole;
+            extras["push"] = {0.0 - d[0], 0.0 - d[1],
+                              0.0 - d[2]};  // frame mm: the way it moves onto the frame
+        }
+        if (step >= 0 && all.plan.steps[size_t(step)].pieces.size() > 1) {
+            json group = json::array();
+            for (uint32_t p : all.plan.steps[size_t(step)].pieces) group.push_back(pieces::pieceName(all, p));
+            extras["glued_group"] = group;
+        }
+        input.pieceExtras.push_back(std::move(extras));
     }
     input.frame = &frame;
     return input;

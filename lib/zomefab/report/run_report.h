@@ -17,6 +17,9 @@ namespace zomefab::report {
 inline constexpr const char* kReportFormatName = "zomefab.report";
 inline constexpr int kReportFormatVersion = 1;
 
+/// The installation plan of @p pieces as the guide's mounting steps (names, glue, pegs).
+std::vector<MountingStep> mountingSteps(const pieces::Pieces& pieces);
+
 /// The report stage (paper §7): the assembly guide of @p frame with @p pieces' tenons, and the
 /// cost report of printing @p pieces against printing @p objectMm whole (Table 1).
 struct RunReports {
