@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include "zomefab/frame/lattice.h"
+
 #include <doctest/doctest.h>
 
 #include <string>
@@ -6,7 +8,6 @@
 #include "frame_fixtures.h"
 #include "zomefab/core/error.h"
 #include "zomefab/frame/frame.h"
-#include "zomefab/frame/lattice.h"
 
 using namespace zomefab;
 
@@ -62,8 +63,10 @@ TEST_CASE("lattice: an object too thin for one cube fails with the sizes involve
         CHECK(e.code() == ErrorCode::ProcessingFailed);
         const std::string m = e.message();
         CHECK(m.find("too thin for one B0 cube") != std::string::npos);
-        CHECK(m.find("80.0 mm across") != std::string::npos);   // the slab's thickness
-        CHECK(m.find("97.0 mm across") != std::string::npos);   // 47.3 + 2 × 24.85
+        CHECK(m.find("at least 24.9 mm inside") != std::string::npos);          // dMin 16 + ball radius 8.85
+        CHECK(m.find("deepest point is 40.0 mm inside") != std::string::npos);  // half the slab
+        CHECK(m.find("needs 65.8 mm") != std::string::npos);                    // 24.85 + 47.3·√3/2
+        CHECK(m.find("scaled up 1.65 times") != std::string::npos);
     }
 }
 

@@ -117,6 +117,7 @@ TEST_CASE("transform: affineInverse undoes a rotation, scale and translation") {
 
 TEST_CASE("tenons: the prism's signed distance and the exact peg mesh") {
     TenonOptions o;
+    o.taperDeg = 0;  // a straight prism here; the taper has its own test below
     Tenon t;
     t.hole = 2;  // blue, +z: the section's long side along x
     t.axisGrid = {0, 0, 1};
@@ -191,9 +192,38 @@ TEST_CASE("tenons: options out of range are usage errors") {
     CHECK(code(o) == int(ErrorCode::Usage));
 }
 
+TEST_CASE("tenons: the stem widens by tan(taper) per mm from the ball's face") {
+    TenonOptions o;  // 7 mm at the face, 4°
+    Tenon t;
+    t.hole = 2;
+    t.axisGrid = {0, 0, 1};
+    t.longSideGrid = {1, 0, 0};
+    t.shoulderMm = 8.85;
+    t.pegTipMm = 8.85 - o.pegDepthMm;
+    t.baseMm = 48.85;
+    t.endMm = 50.85;
+    const double slope = std::tan(4.0 * M_PI / 180.0);
+    CHECK(stemHalfWidthMm(o, 0) == doctest::Approx(3.5));
+    CHECK(stemHalfWidthMm(o, 40) == doctest::Approx(3.5 + 40 * slope));
+    CHECK(stemHalfWidthMm(o, -3) == doctest::Approx(3.5));  // the peg side: no taper
+    // On its side the zero set follows the taper: 20 mm from the face the half-width is 4.9 mm.
+    const double half20 = 3.5 + 20 * slope;
+    CHECK(tenonSignedDistanceMm(t, o, {half20 - 0.05, 0, 8.85 + 20}) < 0);
+    CHECK(tenonSignedDistanceMm(t, o, {half20 + 0.05, 0, 8.85 + 20}) > 0);
+    CHECK(tenonSignedDistanceMm(t, o, {3.6, 0, 8.85 + 1}) > 0);  // near the ball it is 7 mm wide
+    // The strength rule of the default: w(ℓ) ≥ w₀ (ℓ/ℓ₀)^(1/3) from ℓ₀ = 4 + 7 mm up to the longest stem.
+    for (double from = 0; from <= o.maxLengthMm; from += 5) {
+        const double lever = o.pegDepthMm + from;
+        CHECK(2 * stemHalfWidthMm(o, from) >= o.bodyWidthMm * std::cbrt(lever / 11.0) - 1e-9);
+    }
+    const Box3d box = tenonBoundsMm(t, o);
+    CHECK(box.max[0] == doctest::Approx(stemHalfWidthMm(o, t.endMm - t.shoulderMm)));
+}
+
 TEST_CASE("tenons: rays from one ball in a spherical shell") {
     const zome::Structure frame = oneBall();
     TenonOptions o;
+    o.taperDeg = 0;                 // straight stems: the cut at z = 5 then misses the horizontal ones
     o.holes = TenonHoles::Lattice;  // the paper's six
     const double inner = 30.0;
     const auto candidates =
@@ -213,7 +243,7 @@ TEST_CASE("tenons: rays from one ball in a spherical shell") {
     // All 30 blue holes: the six above plus 24 more. Each accepted one reaches the wall
     // straight on, in the piece its axis meets, with the peg's long side along the hole's rectangle;
     // the others are rays whose prism the cut at z = 5 runs through.
-    TenonOptions allBlue;
+    TenonOptions allBlue = o;
     allBlue.holes = TenonHoles::Blue;
     const auto all =
         findTenonCandidates(frame, Transform4d::identity(), sphereProbe(inner, 40.0, 5.0), allBlue);

@@ -84,7 +84,17 @@ TEST_CASE("cost_report: hollow and solid cases against the octree baseline") {
         CHECK(c->zomefab.filament.costUsd ==
               doctest::Approx(filamentUse(c->zomefab.print.filamentMm3, FilamentOptions{}).costUsd));
         CHECK(c->savedFilamentPercent > 0.0);
+        // Printed whole: one part, fewer perimeters than the octree's 8 parts, so less than the
+        // baseline; the savings against it are 1 − ZomeFab / whole.
+        CHECK(c->whole.print.parts == 1);
+        CHECK(c->whole.print.filamentMm3 <= c->baseline.print.filamentMm3);
+        CHECK(c->whole.print.hours() <= c->baseline.print.hours());
+        CHECK(c->savedTimeVsWholePercent ==
+              doctest::Approx(100 * (1 - c->zomefab.totalHours() / c->whole.totalHours())));
+        CHECK(c->savedFilamentVsWholePercent ==
+              doctest::Approx(100 * (1 - c->zomefab.print.filamentMm3 / c->whole.print.filamentMm3)));
     }
+    CHECK(solid.whole.print.filamentMm3 == doctest::Approx(r.objectVolumeMm3).epsilon(1e-6));
     // The paper's observation (§7.2): the benefit grows with the infill rate.
     CHECK(solid.savedMaterialPercent > hollow.savedMaterialPercent);
     CHECK(solid.savedTimePercent > hollow.savedTimePercent);
@@ -100,6 +110,9 @@ TEST_CASE("cost_report: hollow and solid cases against the octree baseline") {
     const std::string md = costReportMarkdown(r);
     CHECK(md.find("| hollow (20%) | ZomeFab |") != std::string::npos);
     CHECK(md.find("| | baseline (8 octree parts) |") != std::string::npos);
+    CHECK(md.find("| | whole object (1 part, large bed) |") != std::string::npos);
+    CHECK(j["cases"][1]["whole"]["print"]["parts"] == 1);
+    CHECK(j["cases"][0]["saved_filament_vs_whole_percent"].is_number());
     CHECK(md.find("| solid (100%) | ZomeFab |") != std::string::npos);
 }
 
@@ -120,12 +133,13 @@ TEST_CASE("cost_report: a part the slicer fails on is estimated instead, with a 
         costReport(object, test::pointersTo(pieces), bunnyParts(), Fabrication{}, o, context);
     CHECK(r.slicerFallbacks ==
           std::vector<std::string>{"hollow piece 0 at 20%", "hollow baseline part 0 at 20%",
-                                   "solid piece 0 at 100%", "solid baseline part 0 at 100%"});
-    REQUIRE(warnings.size() == 4);
+                                   "hollow whole object 0 at 20%", "solid piece 0 at 100%",
+                                   "solid baseline part 0 at 100%", "solid whole object 0 at 100%"});
+    REQUIRE(warnings.size() == 6);
     CHECK(warnings[0].find("false failed on hollow piece 0 at 20%") != std::string::npos);
     const CostReport model = costReport(object, test::pointersTo(pieces), bunnyParts(), Fabrication{});
     CHECK(r.cases[0].zomefab.print.seconds == model.cases[0].zomefab.print.seconds);
-    CHECK(costReportToJson(r)["slicer_fallbacks"].size() == 4);
+    CHECK(costReportToJson(r)["slicer_fallbacks"].size() == 6);
     // A slicer that is not there at all is a usage error, before any work.
     o.slicer.executable = "/nonexistent/prusa-slicer";
     CHECK_THROWS_WITH_AS(

@@ -86,7 +86,9 @@ void FabricationCli::addTo(CLI::App& app, unsigned parts) {
             ->capture_default_str();
     }
     if (parts & kWall)
-        app.add_option("--shell-mm", f.wallMm, "Shell wall thickness in mm (paper: dMin = 16)")
+        app.add_option("--shell-mm", f.wallMm,
+                       "Shell wall thickness in mm (the paper: 16, its d_min; the frame keeps wall + "
+                       "--wall-gap-mm from the surface)")
             ->capture_default_str();
     if (parts & kFrameClearance) {
         app.add_option("--frame-clearance-mm", f.frameClearanceMm,

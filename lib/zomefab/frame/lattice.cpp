@@ -223,14 +223,22 @@ LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptio
     if (cubes[best] == 0) {
         const double deepest = deepestDepthMm(field);
         const double need = options.zone.dMinMm + options.scale.ballRadiusMm();
+        // A cube whose centre sits at the deepest point has its corners b0·√3/2 from it, so they
+        // all lie deep enough when the deepest point is need + b0·√3/2 inside; every placement
+        // tried failed, and the deepest point says by how much the object falls short.
+        const double halfDiagonal = 0.5 * std::sqrt(3.0) * b0;
+        const double wanted = need + halfDiagonal;
+        std::string hint;
+        if (deepest > 0 && deepest < wanted)
+            hint = "; the object scaled up " + formatNumbers("%.2f", wanted / deepest) +
+                   " times (--height-mm) holds one for sure, or use a smaller --frame-clearance-mm";
         throw Error(ErrorCode::ProcessingFailed,
-                    "object too thin for one B0 cube: the thickest inner region found is about " +
-                        formatNumbers("%.1f", 2.0 * std::max(0.0, deepest)) + " mm across (deepest point " +
-                        formatNumbers("%.1f", deepest) +
-                        " mm inside the surface); a cube needs its 8 balls at least " +
-                        formatNumbers("%.1f", need) + " mm inside (dMin + ball radius), a region about " +
-                        formatNumbers("%.1f", b0 + 2.0 * need) + " mm across (b0 + 2 x " +
-                        formatNumbers("%.1f", need) + " mm)");
+                    "object too thin for one B0 cube: none of the " + std::to_string(total) +
+                        " placements tried has all 8 balls at least " + formatNumbers("%.1f", need) +
+                        " mm inside the surface (dMin + ball radius); the deepest point is " +
+                        formatNumbers("%.1f", deepest) + " mm inside, and a cube around it needs " +
+                        formatNumbers("%.1f", wanted) + " mm (" + formatNumbers("%.1f", need) +
+                        " + half the cube's diagonal " + formatNumbers("%.1f", halfDiagonal) + ")" + hint);
     }
 
     const FrameField& ff = fields[best / perRotation];

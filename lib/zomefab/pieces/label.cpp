@@ -145,7 +145,6 @@ std::optional<PieceLabel> placeLabel(const std::string& text, uint32_t piece,
     const Vec3d size = labelSizeMm(text, o);
     const double halfW = 0.5 * size[0], halfH = 0.5 * size[1];
     const double sample = std::max(0.5 * o.strokeMm, 0.5 * probe.voxelMm);
-    const double keepOut = bodyRadiusMm(tenonOptions) + o.marginMm;
     std::optional<PieceLabel> best;
     double bestScore = 1e30;
     size_t tried = 0;
@@ -187,6 +186,8 @@ std::optional<PieceLabel> placeLabel(const std::string& text, uint32_t piece,
                 for (const Tenon& t : tenons) {
                     const double d2 =
                         zome::pointSegmentDistanceSq(q, t.pointAt(t.pegTipMm), t.pointAt(t.endMm));
+                    const double keepOut =
+                        std::sqrt(2.0) * stemHalfWidthMm(tenonOptions, t.endMm - t.shoulderMm) + o.marginMm;
                     if (d2 < keepOut * keepOut) isOk = false;
                 }
             }

@@ -208,7 +208,8 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
     context.progress("pieces", 0.25);
     context.throwIfCancelled();
 
-    planPieces(out, field, cells, grouping, *shell, frame, frameToGridMm, out.options, context);
+    planPieces(out, field, cells, grouping, *shell, frame, frameToGridMm, fabrication.wallMm, out.options,
+               context);
     context.progress("pieces", 0.35);
     context.debug("tenons and labels planned: " + formatNumber(clock.seconds(), 3) + " s");
     context.throwIfCancelled();

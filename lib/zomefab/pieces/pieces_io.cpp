@@ -78,6 +78,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                       {"peg_mm", {pegLongMm(o.tenons), pegShortMm(o.tenons)}},
                       {"peg_depth_mm", o.tenons.pegDepthMm},
                       {"width_mm", o.tenons.bodyWidthMm},
+                      {"taper_deg", o.tenons.taperDeg},
                       {"max_length_mm", o.tenons.maxLengthMm},
                       {"max_tilt_deg", o.tenons.maxTiltDeg},
                       {"embed_mm", o.tenons.embedMm},

@@ -56,6 +56,7 @@ void readOptions(const json& o, PiecesOptions& options) {
     to.clearanceMm = numberFromJson(requireMember(t, "clearance_mm", "tenons"), "tenons.clearance_mm");
     to.pegDepthMm = numberFromJson(requireMember(t, "peg_depth_mm", "tenons"), "tenons.peg_depth_mm");
     to.bodyWidthMm = numberFromJson(requireMember(t, "width_mm", "tenons"), "tenons.width_mm");
+    to.taperDeg = numberFromJson(requireMember(t, "taper_deg", "tenons"), "tenons.taper_deg");
     to.maxLengthMm = numberFromJson(requireMember(t, "max_length_mm", "tenons"), "tenons.max_length_mm");
     to.maxTiltDeg = numberFromJson(requireMember(t, "max_tilt_deg", "tenons"), "tenons.max_tilt_deg");
     to.embedMm = numberFromJson(requireMember(t, "embed_mm", "tenons"), "tenons.embed_mm");

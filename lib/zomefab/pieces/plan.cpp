@@ -135,12 +135,13 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
 
 void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
                 const FloatGrid& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
-                const PiecesOptions& opt, const RunContext& context) {
+                double wallMm, const PiecesOptions& opt, const RunContext& context) {
     const FloatGrid::ConstAccessor probeAccessor = shell.getConstAccessor();
     const openvdb::tools::GridSampler<FloatGrid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
         probeAccessor, shell.transform());
     ShellProbe probe;
     probe.voxelMm = field.voxelMm;
+    probe.wallMm = wallMm;
     probe.signedDistanceMm = [&](const Vec3d& p) {
         return double(sampler.wsSample(openvdb::Vec3d(p[0], p[1], p[2])));
     };

@@ -37,6 +37,8 @@ constexpr double kPi = 3.14159265358979323846;
 /// where a prism would meet a peg into a fillet of up to half a voxel, which would sit in the hole's
 /// mouth; the exact peg mesh spans the gap instead.
 constexpr double kPrismGapMm = 0.3;
+/// Wall left between a stem's end and the outer surface, mm: two perimeters of a 0.4 mm nozzle.
+constexpr double kOuterSkinMm = 1.0;
 /// How far the peg mesh reaches back into the prism (mm), so the two overlap.
 constexpr double kPegRootMm = 1.5;
 /// The chamfer around the peg's tip (mm, 45°): it finds the hole before the peg's full section does.
@@ -60,19 +62,6 @@ double bisect(const ShellProbe& probe, const Vec3d& origin, const Vec3d& dir, do
     return 0.5 * (t0 + t1);
 }
 
-/// Signed distance to a convex polygon (counter-clockwise) in its plane: the largest of its edge
-/// lines' distances. Exact inside, a lower bound outside.
-double polygonDistance(const std::vector<std::array<double, 2>>& poly, double x, double y) {
-    double d = -1e300;
-    for (size_t i = 0; i < poly.size(); ++i) {
-        const auto& a = poly[i];
-        const auto& b = poly[(i + 1) % poly.size()];
-        const double ex = b[0] - a[0], ey = b[1] - a[1], len = std::hypot(ex, ey);
-        d = std::max(d, ((x - a[0]) * ey - (y - a[1]) * ex) / len);  // > 0 right of a→b: outside
-    }
-    return d;
-}
-
 /// The tenon of @p ball along @p hole before the shell is asked: axes, ball centre, shoulder, tip.
 Tenon tenonAlong(const zome::Structure& frame, zome::BallId id, int hole, const Transform4d& frameToGridMm,
                  const TenonOptions& o) {
@@ -91,25 +80,32 @@ Tenon tenonAlong(const zome::Structure& frame, zome::BallId id, int hole, const 
 /// The prism stays in its piece: wherever it is inside the shell it is this piece's, and its end
 /// face lies in this piece's wall with at least half a voxel of wall beyond. The rejection, or empty.
 std::string containment(const Tenon& t, int64_t piece, const ShellProbe& probe, const TenonOptions& o) {
-    const double step = 0.5 * probe.voxelMm, halfWidth = 0.5 * o.bodyWidthMm;
+    const double step = 0.5 * probe.voxelMm;
     const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
-    bool isEndOutside = false;
     const int lateral = 4;  // 5 × 5 samples across the section
+    int endInWall = 0, endSamples = 0;
+    bool isCentreIn = false;
     for (int i = 0; i <= lateral; ++i)
         for (int j = 0; j <= lateral; ++j) {
-            const double l = -halfWidth + 2 * halfWidth * i / lateral,
-                         s = -halfWidth + 2 * halfWidth * j / lateral;
-            const Vec3d offset = add(scale(t.longSideGrid, l), scale(shortSide, s));
+            const double fl = -1.0 + 2.0 * i / lateral, fs = -1.0 + 2.0 * j / lateral;
+            auto at = [&](double a) {
+                const double half = stemHalfWidthMm(o, a - t.shoulderMm);
+                return add(t.pointAt(a), add(scale(t.longSideGrid, fl * half), scale(shortSide, fs * half)));
+            };
             for (double a = t.shoulderMm; a <= t.endMm + 1e-9; a += step) {
-                const Vec3d q = add(t.pointAt(a), offset);
+                const Vec3d q = at(a);
                 if (probe.signedDistanceMm(q) < 0 && probe.pieceAt(q) != piece)
                     return "crosses another piece";
             }
-            const Vec3d e = add(t.pointAt(t.endMm), offset);
-            if (!(probe.signedDistanceMm(e) < -0.5 * probe.voxelMm) || probe.pieceAt(e) != piece)
-                isEndOutside = true;
+            const Vec3d e = at(t.endMm);
+            const bool isIn = probe.signedDistanceMm(e) < -0.5 * probe.voxelMm && probe.pieceAt(e) == piece;
+            endInWall += isIn ? 1 : 0;
+            ++endSamples;
+            if (i == lateral / 2 && j == lateral / 2) isCentreIn = isIn;
         }
-    return isEndOutside ? "too close to the piece's edge" : "";
+    // The end face bonds to the wall: its centre and most of it (a tilted thin wall may leave a
+    // corner in the air, never a corner in another piece).
+    return isCentreIn && 3 * endInWall >= 2 * endSamples ? "" : "too close to the piece's edge";
 }
 
 /// One ray's candidate: where it meets the wall, which piece, and why it cannot be a tenon.
@@ -146,8 +142,15 @@ TenonCandidate candidateAlong(const zome::Structure& frame, zome::BallId id, int
     const double cosTilt = std::clamp(-dot(t.axisGrid, n), -1.0, 1.0);
     t.tiltDeg = std::acos(cosTilt) * 180.0 / kPi;
     if (!(t.tiltDeg <= o.maxTiltDeg)) return c.rejection = "surface too oblique", c;
-    // Deep enough that the whole end face is in the wall on a tilted surface.
-    t.endMm = hit + o.embedMm + bodyRadiusMm(o) * std::tan(t.tiltDeg * kPi / 180.0);
+    // Deep enough that the whole end face is in the wall on a tilted surface, but never through a
+    // thin wall: on a locally flat wall the section's nearest corner leaves the outer surface at
+    // hit − r·tan(tilt) + wall/cos(tilt); keep kOuterSkinMm of wall beyond it (printed solid).
+    const double tanTilt = std::tan(t.tiltDeg * kPi / 180.0);
+    const double r = std::sqrt(2.0) * stemHalfWidthMm(o, hit - t.shoulderMm);
+    const double deepest =
+        hit - r * tanTilt + probe.wallMm / std::cos(t.tiltDeg * kPi / 180.0) - kOuterSkinMm;
+    t.endMm = std::min(hit + o.embedMm + r * tanTilt, deepest);
+    if (t.endMm < hit + 0.5 * probe.voxelMm) return c.rejection = "surface too oblique for the wall", c;
     const std::string obstruction = tenonObstruction(frame, t, o);
     if (!obstruction.empty())
         return c.rejection = obstruction.rfind("strut", 0) == 0 ? "strut in the way" : "ball in the way", c;
@@ -198,6 +201,7 @@ void checkTenonOptions(const TenonOptions& o) {
     requireRange(o.clearanceMm, 0.0, 0.5, "the tenon clearance", "mm");
     requireRange(o.pegDepthMm, 1.0, 8.0, "the peg depth", "mm");
     requireRange(o.bodyWidthMm, pegLongMm(o), 20.0, "the tenon width", "mm");
+    requireRange(o.taperDeg, 0.0, 15.0, "the tenon taper", "degrees");
     requireRange(o.maxLengthMm, 1.0, 200.0, "the longest tenon", "mm");
     requireRange(o.maxTiltDeg, 0.0, 60.0, "the largest tenon tilt", "degrees");
     requireRange(o.embedMm, 0.5, 10.0, "the tenon's depth in the wall", "mm");
@@ -216,6 +220,10 @@ double pegShortMm(const TenonOptions& o) {
 
 double bodyRadiusMm(const TenonOptions& o) { return o.bodyWidthMm * std::sqrt(0.5); }
 
+double stemHalfWidthMm(const TenonOptions& o, double fromFaceMm) {
+    return 0.5 * o.bodyWidthMm + std::max(0.0, fromFaceMm) * std::tan(o.taperDeg * kPi / 180.0);
+}
+
 std::vector<std::array<double, 2>> pegSectionMm(int hole, const TenonOptions& o) {
     return zome::insetPolygon(zome::holeSectionMm(zome::holeColor(hole)), o.clearanceMm);
 }
@@ -226,7 +234,10 @@ double tenonSignedDistanceMm(const Tenon& t, const TenonOptions& o, const Vec3d&
     const double a = dot(d, t.axisGrid), l = dot(d, t.longSideGrid), s = dot(d, shortSide);
     const double start = t.shoulderMm + kPrismGapMm;
     const double bodyMid = 0.5 * (start + t.endMm), bodyHalf = 0.5 * (t.endMm - start);
-    return boxDistance({a - bodyMid, l, s}, {bodyHalf, 0.5 * o.bodyWidthMm, 0.5 * o.bodyWidthMm});
+    // The frustum by the box of its section at p's depth along the axis: the zero set is exact,
+    // distances off it are within 1/cos(taper) of the true ones.
+    const double half = stemHalfWidthMm(o, std::clamp(a, start, t.endMm) - t.shoulderMm);
+    return boxDistance({a - bodyMid, l, s}, {bodyHalf, half, half});
 }
 
 TriMesh pegMesh(const Tenon& t, const TenonOptions& o) {
@@ -261,7 +272,8 @@ TriMesh pegMesh(const Tenon& t, const TenonOptions& o) {
 Box3d tenonBoundsMm(const Tenon& t, const TenonOptions& o) {
     Box3d box;
     const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
-    const double half = 0.5 * o.bodyWidthMm;  // ≥ every peg's half section (checkTenonOptions)
+    // The widest section is the stem's end; the peg is narrower than the stem (checkTenonOptions).
+    const double half = stemHalfWidthMm(o, t.endMm - t.shoulderMm);
     for (double a : {t.pegTipMm, t.endMm})
         for (double l : {-half, half})
             for (double s : {-half, half})
@@ -272,20 +284,26 @@ Box3d tenonBoundsMm(const Tenon& t, const TenonOptions& o) {
 std::string tenonObstruction(const zome::Structure& frame, const Tenon& t, const TenonOptions& o) {
     // The prism as a capsule around its axis, in the frame's mm (the exact hole direction).
     const zome::Ball& ball = frame.ball(t.ball);
-    const Vec3d a = madd(ball.positionMm, t.shoulderMm, t.axisFrame);
-    const Vec3d b = madd(ball.positionMm, t.endMm, t.axisFrame);
-    const double r = bodyRadiusMm(o) + o.frameClearanceMm;
-    for (zome::StrutId id : frame.strutIds()) {
-        const zome::Strut& s = frame.strut(id);
-        const double limit = r + frame.scale().strutRadiusMm(s.color);
-        if (zome::segmentSegmentDistanceSq(a, b, s.startMm, s.endMm) < limit * limit)
-            return "strut " + std::to_string(id) + " (" + zome::partName(s.color, s.size) + ") in the way";
-    }
-    const double ballLimit = r + frame.scale().ballRadiusMm();
-    for (zome::BallId id : frame.ballIds()) {
-        if (id == t.ball) continue;
-        if (zome::pointSegmentDistanceSq(frame.ball(id).positionMm, a, b) < ballLimit * ballLimit)
-            return "ball " + std::to_string(id) + " in the way";
+    // The tapered stem as a chain of short capsules, each with the radius of its wider end.
+    const double stepMm = 2.0, lengthMm = t.endMm - t.shoulderMm;
+    for (double from = 0; from < lengthMm; from += stepMm) {
+        const double to = std::min(lengthMm, from + stepMm);
+        const Vec3d a = madd(ball.positionMm, t.shoulderMm + from, t.axisFrame);
+        const Vec3d b = madd(ball.positionMm, t.shoulderMm + to, t.axisFrame);
+        const double r = std::sqrt(2.0) * stemHalfWidthMm(o, to) + o.frameClearanceMm;
+        for (zome::StrutId id : frame.strutIds()) {
+            const zome::Strut& s = frame.strut(id);
+            const double limit = r + frame.scale().strutRadiusMm(s.color);
+            if (zome::segmentSegmentDistanceSq(a, b, s.startMm, s.endMm) < limit * limit)
+                return "strut " + std::to_string(id) + " (" + zome::partName(s.color, s.size) +
+                       ") in the way";
+        }
+        const double ballLimit = r + frame.scale().ballRadiusMm();
+        for (zome::BallId id : frame.ballIds()) {
+            if (id == t.ball) continue;
+            if (zome::pointSegmentDistanceSq(frame.ball(id).positionMm, a, b) < ballLimit * ballLimit)
+                return "ball " + std::to_string(id) + " in the way";
+        }
     }
     return {};
 }
@@ -315,13 +333,17 @@ TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, const std:
         if (rejection[i].empty()) byPiece[size_t(p)].push_back(i);
     }
     std::vector<const Tenon*> chosen;
-    const double minGap = 2 * bodyRadiusMm(o) + o.frameClearanceMm;
+    auto endRadius = [&](const Tenon& t) {
+        return std::sqrt(2.0) * stemHalfWidthMm(o, t.endMm - t.shoulderMm);
+    };
     auto conflicts = [&](const Tenon& t) {
-        for (const Tenon* c : chosen)
+        for (const Tenon* c : chosen) {
+            const double minGap = endRadius(t) + endRadius(*c) + o.frameClearanceMm;
             if (zome::segmentSegmentDistanceSq(t.pointAt(t.shoulderMm), t.pointAt(t.endMm),
                                                c->pointAt(c->shoulderMm),
                                                c->pointAt(c->endMm)) < minGap * minGap)
                 return true;
+        }
         return false;
     };
     // How much a candidate spreads the piece's tenons: its distance to the balls already chosen,

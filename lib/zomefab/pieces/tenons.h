@@ -41,9 +41,16 @@ struct TenonOptions {
     /// Gap between the peg and the hole on every side; the peg is the hole's section inset by this.
     /// With a 4 mm peg, 0.15 mm lets the piece go on up to about 2° off its direction.
     double clearanceMm = 0.15;
-    double pegDepthMm = 4.0;    ///< how far the peg enters the hole (ZomeFab's LATCH, 4 mm)
-    double bodyWidthMm = 7.0;   ///< side of the square prism from the wall to the ball's face
-    double maxLengthMm = 40.0;  ///< longest prism, from the ball's face to the inner surface
+    double pegDepthMm = 4.0;   ///< how far the peg enters the hole (ZomeFab's LATCH, 4 mm)
+    double bodyWidthMm = 7.0;  ///< side of the square stem at the ball's face
+    /// Half-angle of the stem's taper (a boss that widens toward the wall): each side moves out by
+    /// tan(taperDeg) per mm from the ball's face. A lateral force F at the peg bends a section ℓ
+    /// from the peg's tip with stress 6Fℓ/w³ (a square of side w), so a stem as strong as its
+    /// root needs w(ℓ) ≥ w₀ (ℓ/ℓ₀)^(1/3); 4° keeps that up to maxLengthMm (docs/pieces.md).
+    double taperDeg = 4.0;
+    /// Longest stem, from the ball's face to the inner surface: a thin wall stands up to d_min
+    /// (16 mm) from the frame, so the stems bridge that gap and the forbidden zone's depth.
+    double maxLengthMm = 60.0;
     /// Largest angle between the tenon's axis and the inner surface's normal (§6.1: "perpendicular").
     /// The prism's end is buried deeper on a tilted wall, so the bond does not suffer.
     double maxTiltDeg = 35.0;
@@ -68,6 +75,8 @@ double pegShortMm(const TenonOptions& o);
 inline double maxVoxelForTenonsMm(const TenonOptions& o) { return 0.5 * o.bodyWidthMm; }
 /// Radius of the capsule around the prism that the collision tests use (its half-diagonal).
 double bodyRadiusMm(const TenonOptions& o);
+/// Half the stem's side @p fromFaceMm from the ball's face (the taper), mm.
+double stemHalfWidthMm(const TenonOptions& o, double fromFaceMm);
 
 /// One tenon. Distances are along the axis from the ball's centre, in mm.
 struct Tenon {
@@ -114,6 +123,7 @@ struct ShellProbe {
     /// farther out. Callers ask φ first: only points with φ < 0 are in the piece's material.
     std::function<int64_t(const Vec3d&)> pieceAt;
     double voxelMm = 1.0;
+    double wallMm = 16.0;  ///< the wall's thickness (Fabrication::wallMm): a stem's end stays inside it
 
     /// Unit normal of the shell's level set at @p p (outward of the material: out of the wall), by
     /// central differences half a voxel apart.

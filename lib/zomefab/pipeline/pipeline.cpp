@@ -93,6 +93,7 @@ void makePieces(report::RunRecord& run, const RunOptions& options, RunContext& c
         return pieces::makePieces(run.shell, run.frame.structure, frameToGridMm, run.partition,
                                   run.fabrication, options.pieces, context);
     });
+    pieces::requireBuildable(run.pieces);  // exit 3 with the plan's reasons; nothing is written
 }
 
 /// Stage 7: what the user reads (paper §7): the assembly guide and the cost report (Table 1).

@@ -38,8 +38,11 @@ std::string costLine(const CostCase& c) {
                          c.zomefab.filament.massG / 1000.0, c.zomefab.filament.costUsd) +
            formatNumbers(" + Zometool %.2f USD, %.1f h to build", c.zomefab.zomeUsd,
                          c.zomefab.assemblyHours) +
-           formatNumbers("; whole object %.1f h, %.2f USD", c.baseline.print.hours(), c.baseline.totalUsd()) +
-           formatNumbers(": saves %.0f%% time, %.0f%% material", c.savedTimePercent, c.savedMaterialPercent);
+           formatNumbers("; octree baseline %.1f h, %.2f USD", c.baseline.print.hours(),
+                         c.baseline.totalUsd()) +
+           formatNumbers(": saves %.0f%% time, %.0f%% material", c.savedTimePercent, c.savedMaterialPercent) +
+           formatNumbers("; printed whole %.1f h: saves %.0f%% time, %.0f%% filament", c.whole.print.hours(),
+                         c.savedTimeVsWholePercent, c.savedFilamentVsWholePercent);
 }
 
 json levelSetsJson(const RunRecord& run) {

@@ -23,7 +23,7 @@ namespace zomefab::pieces::detail {
 /// against the shell @p shell. Warnings for pieces short of tenons or numbers.
 void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
                 const FloatGrid& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
-                const PiecesOptions& options, const RunContext& context);
+                double wallMm, const PiecesOptions& options, const RunContext& context);
 
 /// For every piece, the leaves that hold its inside voxels and their 26 neighbours (the band is
 /// three voxels wide).
