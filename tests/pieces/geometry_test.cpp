@@ -115,17 +115,25 @@ TEST_CASE("transform: affineInverse undoes a rotation, scale and translation") {
     CHECK_THROWS_AS(affineInverse(singular), Error);
 }
 
-TEST_CASE("tenons: the prism's signed distance and the exact peg mesh") {
-    TenonOptions o;
-    o.taperDeg = 0;  // a straight prism here; the taper has its own test below
+namespace {
+/// A tenon of a ball at the origin along hole 2 (blue, +z: the section's long side along x).
+Tenon tenonUp(const TenonOptions& o, double baseMm, double endMm) {
     Tenon t;
-    t.hole = 2;  // blue, +z: the section's long side along x
+    t.hole = 2;
     t.axisGrid = {0, 0, 1};
     t.longSideGrid = {1, 0, 0};
     t.shoulderMm = 8.85;
     t.pegTipMm = 8.85 - o.pegDepthMm;
-    t.baseMm = 30;
-    t.endMm = 32;
+    t.baseMm = baseMm;
+    t.endMm = endMm;
+    return t;
+}
+}  // namespace
+
+TEST_CASE("tenons: the prism's signed distance and the exact peg mesh") {
+    TenonOptions o;
+    o.taperDeg = 0;  // a straight prism here; the taper has its own test below
+    const Tenon t = tenonUp(o, 30, 32);
     // Prism: 7 × 7 mm from 0.3 mm past the shoulder to z = 32; the peg is not in it.
     CHECK(tenonSignedDistanceMm(t, o, {3.4, 3.4, 20}) < 0);
     CHECK(tenonSignedDistanceMm(t, o, {3.6, 0, 20}) == doctest::Approx(0.1));
@@ -194,14 +202,7 @@ TEST_CASE("tenons: options out of range are usage errors") {
 
 TEST_CASE("tenons: the stem widens by tan(taper) per mm from the ball's face") {
     TenonOptions o;  // 7 mm at the face, 4°
-    Tenon t;
-    t.hole = 2;
-    t.axisGrid = {0, 0, 1};
-    t.longSideGrid = {1, 0, 0};
-    t.shoulderMm = 8.85;
-    t.pegTipMm = 8.85 - o.pegDepthMm;
-    t.baseMm = 48.85;
-    t.endMm = 50.85;
+    const Tenon t = tenonUp(o, 48.85, 50.85);
     const double slope = std::tan(4.0 * M_PI / 180.0);
     CHECK(stemHalfWidthMm(o, 0) == doctest::Approx(3.5));
     CHECK(stemHalfWidthMm(o, 40) == doctest::Approx(3.5 + 40 * slope));
