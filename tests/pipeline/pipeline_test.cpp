@@ -102,24 +102,43 @@ TEST_CASE("staged directory: refuses to replace a directory that is not a zomefa
     fs::create_directories(target);
     test::writeBytes(target + "/thesis.tex", "do not delete");
     {
-        StagedDirectory staged(target, "report.json");
+        StagedDirectory staged(target);
         test::writeBytes(staged.file("report.json"), "{}");
         CHECK_THROWS_AS(staged.commit(), Error);
     }
     CHECK(fs::exists(target + "/thesis.tex"));
     CHECK(!fs::exists(target + "/report.json"));
-    // An earlier output (with the marker) is replaced; nothing else is left behind.
-    const std::string previous = dir.file("previous");
-    fs::create_directories(previous);
-    test::writeBytes(previous + "/report.json", "old");
-    test::writeBytes(previous + "/stale.stl", "old");
+    // A directory that merely holds a report.json next to other work is not an output either.
+    fs::create_directories(target + "/src");
+    test::writeBytes(target + "/report.json", "{}");
     {
-        StagedDirectory staged(previous, "report.json");
+        StagedDirectory staged(target);
+        test::writeBytes(staged.file("report.json"), "{}");
+        CHECK_THROWS_WITH_AS(staged.commit(), doctest::Contains(".zomefab-output"), Error);
+    }
+    CHECK(fs::exists(target + "/thesis.tex"));
+    // An earlier output (its manifest lists all it holds) is replaced; nothing else is left behind.
+    const std::string previous = dir.file("previous");
+    {
+        StagedDirectory staged(previous);
+        test::writeBytes(staged.file("report.json"), "old");
+        test::writeBytes(staged.file("stale.stl"), "old");
+        staged.commit();
+    }
+    CHECK(readInputBytes(previous + "/.zomefab-output") == "report.json\nstale.stl\n");
+    {
+        StagedDirectory staged(previous);
         test::writeBytes(staged.file("report.json"), "new");
         staged.commit();
     }
     CHECK(readInputBytes(previous + "/report.json") == "new");
     CHECK(!fs::exists(previous + "/stale.stl"));
+    // A staging directory left by a run that was killed (its process is gone) goes with the next run.
+    const std::string stale = dir.file(".previous.tmp4194303");  // above Linux's largest pid
+    fs::create_directories(stale);
+    test::writeBytes(stale + "/half.stl", "x");
+    { StagedDirectory staged(previous); }
+    CHECK(!fs::exists(stale));
     size_t entries = 0;
     for (const auto& e : fs::directory_iterator(dir.path())) entries += e.is_directory() ? 1 : 0;
     CHECK(entries == 2);

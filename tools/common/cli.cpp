@@ -20,16 +20,21 @@ namespace {
 
 std::atomic<bool> gInterrupted{false};
 
-extern "C" void onInterrupt(int) {
+/// SIGINT, SIGTERM and SIGHUP all cancel the run: the work stops at the next check, the staging
+/// directory and any child process (PrusaSlicer, batch workers) go, and the tool exits 5.
+extern "C" void onInterrupt(int signal) {
     gInterrupted.store(true);
-    std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C kills at once
+    std::signal(signal, SIG_DFL);  // a second one kills at once
 }
 
 const char* levelPrefix(LogLevel level) {
     switch (level) {
-    case LogLevel::Debug: return "debug: ";
-    case LogLevel::Info: return "";
-    case LogLevel::Warning: return "warning: ";
+        case LogLevel::Debug:
+            return "debug: ";
+        case LogLevel::Info:
+            return "";
+        case LogLevel::Warning:
+            return "warning: ";
     }
     return "";
 }
@@ -80,8 +85,8 @@ int Tool::run(int argc, char** argv, const std::function<int(nlohmann::json&)>& 
     auto lastPrint = std::make_shared<double>(-1.0);
     auto lastStage = std::make_shared<std::string>();
     auto lastFraction = std::make_shared<double>(-1.0);
-    auto progress = [toolName, verbosity, stageClock, lastPrint, lastStage, lastFraction](const std::string& stage,
-                                                                                          double fraction) {
+    auto progress = [toolName, verbosity, stageClock, lastPrint, lastStage, lastFraction](
+                        const std::string& stage, double fraction) {
         if (verbosity < 0) return;
         const double now = stageClock->seconds();
         const bool isNewStage = stage != *lastStage;
@@ -96,12 +101,12 @@ int Tool::run(int argc, char** argv, const std::function<int(nlohmann::json&)>& 
                      int(fraction * 100.0 + 0.5), now);
     };
     mContext = std::make_unique<RunContext>(log, progress, &gInterrupted);
-    std::signal(SIGINT, onInterrupt);
+    for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, onInterrupt);
 
     std::unique_ptr<tbb::global_control> threadLimit;
     if (mCommon.threads > 0)
-        threadLimit = std::make_unique<tbb::global_control>(
-            tbb::global_control::max_allowed_parallelism, size_t(mCommon.threads));
+        threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                            size_t(mCommon.threads));
 
     try {
         nlohmann::json report;

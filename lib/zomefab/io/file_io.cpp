@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "zomefab/io/file_io.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <iostream>
 #include <iterator>
 #include <sstream>
+#include <vector>
 
 #include "zomefab/core/error.h"
 
@@ -67,8 +69,46 @@ void writeOutputAtomic(const std::string& path, const std::function<void(std::os
     }
 }
 
-StagedDirectory::StagedDirectory(const std::string& target, const std::string& markerFile)
-    : mTarget(target), mMarker(markerFile) {
+namespace {
+
+/// Removes the staging directories ".NAME.tmpPID" next to @p target whose process has ended (a
+/// run killed by a signal it could not catch).
+void removeStaleStaging(const fs::path& parent, const std::string& name) {
+    const std::string prefix = "." + name + ".tmp";
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(parent, ec)) {
+        const std::string n = entry.path().filename().string();
+        if (n.compare(0, prefix.size(), prefix) != 0 || n.size() == prefix.size()) continue;
+        const std::string digits = n.substr(prefix.size());
+        if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) continue;
+        const long pid = std::strtol(digits.c_str(), nullptr, 10);
+        if (pid <= 0 || (::kill(pid_t(pid), 0) == 0 || errno != ESRCH)) continue;  // alive, or not ours
+        std::error_code rm;
+        fs::remove_all(entry.path(), rm);
+    }
+}
+
+/// Why @p target may not be replaced, or empty: everything in it must be listed in its manifest.
+std::string replaceRefusal(const fs::path& target) {
+    std::error_code ec;
+    if (fs::is_empty(target, ec)) return {};
+    const fs::path manifest = target / kOutputManifestFile;
+    std::ifstream in(manifest);
+    if (!in) return std::string("is not an output of zomefab (no ") + kOutputManifestFile + ")";
+    std::vector<std::string> listed{kOutputManifestFile};
+    for (std::string line; std::getline(in, line);)
+        if (!line.empty()) listed.push_back(line);
+    for (const auto& entry : fs::directory_iterator(target, ec)) {
+        const std::string n = entry.path().filename().string();
+        if (std::find(listed.begin(), listed.end(), n) == listed.end())
+            return "holds " + n + ", which zomefab did not write";
+    }
+    return {};
+}
+
+}  // namespace
+
+StagedDirectory::StagedDirectory(const std::string& target) : mTarget(target) {
     fs::path t(target);
     while (!t.empty() && t.filename().empty()) t = t.parent_path();  // "out/" -> "out"
     if (t.empty()) throw Error(ErrorCode::WriteFailed, "empty output directory name", target);
@@ -79,6 +119,7 @@ StagedDirectory::StagedDirectory(const std::string& target, const std::string& m
         throw Error(ErrorCode::WriteFailed, "parent directory does not exist: " + parent.string(), target);
     if (fs::exists(t, ec) && !fs::is_directory(t, ec))
         throw Error(ErrorCode::WriteFailed, "exists and is not a directory", target);
+    removeStaleStaging(parent, t.filename().string());
     mStaging = (parent / ("." + t.filename().string() + ".tmp" + std::to_string(::getpid()))).string();
     fs::remove_all(mStaging, ec);
     if (!fs::create_directory(mStaging, ec))
@@ -99,12 +140,22 @@ void StagedDirectory::commitAs(const std::string& target) {
 void StagedDirectory::commit() {
     std::error_code ec;
     const fs::path target(mTarget);
+    {
+        // The manifest: what this output holds, so a later run knows what it may replace.
+        std::vector<std::string> names;
+        for (const auto& entry : fs::directory_iterator(mStaging, ec))
+            if (entry.path().filename() != kOutputManifestFile)
+                names.push_back(entry.path().filename().string());
+        std::sort(names.begin(), names.end());
+        std::ofstream out(fs::path(mStaging) / kOutputManifestFile);
+        for (const std::string& n : names) out << n << '\n';
+        if (!out) throw Error(ErrorCode::WriteFailed, "cannot write the output manifest", mTarget);
+    }
+    if (fs::is_symlink(target, ec) || (fs::exists(target, ec) && !fs::is_directory(target, ec)))
+        throw Error(ErrorCode::WriteFailed, "exists and is not a directory; not replacing it", mTarget);
     if (fs::exists(target, ec)) {
-        const bool isEmpty = fs::is_empty(target, ec);
-        if (!isEmpty && !fs::exists(target / mMarker, ec))
-            throw Error(ErrorCode::WriteFailed,
-                        "exists and is not an output of this tool (no " + mMarker + "); not replacing it",
-                        mTarget);
+        const std::string refusal = replaceRefusal(target);
+        if (!refusal.empty()) throw Error(ErrorCode::WriteFailed, refusal + "; not replacing it", mTarget);
         const fs::path old = target.string() + ".old" + std::to_string(::getpid());
         fs::rename(target, old, ec);
         if (ec)

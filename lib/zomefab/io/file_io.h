@@ -17,14 +17,19 @@ std::string readInputBytes(const std::string& path);
 /// @throw Error(WriteFailed) naming the file; whatever @p write throws is rethrown after cleanup.
 void writeOutputAtomic(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+/// The file every output directory zomefab writes carries: one name per line of what it wrote.
+inline constexpr const char* kOutputManifestFile = ".zomefab-output";
+
 /// An output directory built in a temporary sibling and moved into place by commit(), so a run that
 /// fails (or is interrupted) leaves no half-written directory. Without commit() the staging
-/// directory is removed. commit() replaces an existing target only when it is empty or holds
-/// @p markerFile (a previous output of the same tool); anything else is refused, never deleted.
+/// directory is removed. commit() writes kOutputManifestFile, the list of what it holds, and
+/// replaces an existing target only when it is empty or holds nothing but what its own manifest
+/// lists (a previous zomefab output); anything else is refused, never deleted. Staging
+/// directories left by a killed run (".NAME.tmpPID" whose process is gone) are removed.
 class StagedDirectory {
 public:
     /// @throw Error(WriteFailed) when the parent directory does not exist or is not writable.
-    StagedDirectory(const std::string& target, const std::string& markerFile);
+    explicit StagedDirectory(const std::string& target);
     ~StagedDirectory();
     StagedDirectory(const StagedDirectory&) = delete;
     StagedDirectory& operator=(const StagedDirectory&) = delete;
@@ -41,7 +46,6 @@ public:
 
 private:
     std::string mTarget;
-    std::string mMarker;
     std::string mStaging;
     bool mCommitted = false;
 };

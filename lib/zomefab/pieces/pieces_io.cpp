@@ -206,7 +206,7 @@ void writePieceFiles(const Pieces& all, const std::string& directory, const Piec
 }
 
 void writePieces(const Pieces& all, const std::string& directory, const PiecesJsonInfo& info) {
-    StagedDirectory staging(directory, kPiecesFile);
+    StagedDirectory staging(directory);
     writePieceFiles(all, staging.path(), info);
     writePiecesThreeMf(all, staging.file("pieces.3mf"));
     staging.commit();

@@ -27,7 +27,7 @@ std::string failedDirectory(const std::string& outDir) {
 
 RunOutputs writeRunOutputs(const report::RunRecord& run, const RunOptions& options, nlohmann::json report,
                            const std::string& outDir, const RunContext& context) {
-    StagedDirectory staged(outDir, kRunMarkerFile);
+    StagedDirectory staged(outDir);
     std::vector<std::string> written;
     auto write = [&](const std::string& name, const std::function<void(std::ostream&)>& body) {
         writeOutputAtomic(staged.file(name), body);
