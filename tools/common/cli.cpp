@@ -3,6 +3,7 @@
 
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -25,6 +26,23 @@ std::atomic<bool> gInterrupted{false};
 extern "C" void onInterrupt(int signal) {
     gInterrupted.store(true);
     std::signal(signal, SIG_DFL);  // a second one kills at once
+}
+
+/// A seed is a decimal integer in [0, 2^64 − 1]: CLI11 would saturate a larger one silently.
+CLI::Validator seedValidator() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            const std::string largest = "18446744073709551615";
+            const bool isDigits = !text.empty() && std::all_of(text.begin(), text.end(),
+                                                               [](char c) { return c >= '0' && c <= '9'; });
+            std::string digits = text;
+            digits.erase(0, std::min(digits.find_first_not_of('0'), digits.size() - 1));
+            if (!isDigits || digits.size() > largest.size() ||
+                (digits.size() == largest.size() && digits > largest))
+                return "the seed must be an integer from 0 to " + largest + ", got " + text;
+            return {};
+        },
+        "0..2^64-1");
 }
 
 const char* levelPrefix(LogLevel level) {
@@ -50,6 +68,7 @@ Tool::Tool(std::string name, std::string description)
         ->check(CLI::NonNegativeNumber)
         ->default_val(0);
     mApp.add_option("--seed", mCommon.seed, "Random seed; same seed and input give the same output")
+        ->check(seedValidator())
         ->default_val(1);
     mApp.add_option("--report", mCommon.reportPath, "Also write a JSON report to this file");
     mApp.get_formatter()->column_width(34);

@@ -137,6 +137,7 @@ void FrameCli::addTo(CLI::App& app) {
         ->check(CLI::Range(1, 4096));
     app.add_option("--iterations", o.anneal.maxIterations,
                    "Annealing iterations per chain (0 = until T < --t-end)")
+        ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
     app.add_option("--time-limit", o.anneal.timeLimitSeconds,
                    "Wall-clock budget per chain in seconds (0 = none; makes the result timing-dependent)")
@@ -278,13 +279,21 @@ void CostCli::addTo(CLI::App& app) {
            "Print times and filament from: estimator (built in) or prusa-slicer (runs it on every part)")
         ->capture_default_str()
         ->check(CLI::IsMember({"estimator", "prusa-slicer"}));
-    app.add_option("--filament-mm", cost.filament.diameterMm, "Filament diameter")->capture_default_str();
+    app.add_option("--filament-mm", cost.filament.diameterMm, "Filament diameter")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
     app.add_option("--filament-g-per-cm3", cost.filament.densityGPerCm3, "Filament density")
+        ->check(CLI::PositiveNumber)
         ->capture_default_str();
     app.add_option("--filament-usd-per-m", cost.filament.usdPerM, "Filament price per metre")
+        ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
-    app.add_option("--strut-usd", cost.prices.strutUsd, "Price of one Zometool strut")->capture_default_str();
-    app.add_option("--ball-usd", cost.prices.ballUsd, "Price of one Zometool ball")->capture_default_str();
+    app.add_option("--strut-usd", cost.prices.strutUsd, "Price of one Zometool strut")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    app.add_option("--ball-usd", cost.prices.ballUsd, "Price of one Zometool ball")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
 }
 
 report::CostOptions CostCli::resolve() const {
