@@ -103,8 +103,8 @@ TEST_CASE("assembly_guide: the mounting steps, in order, and their checks") {
     steps[0].pieces = {"piece-01"};
     steps[0].hole = 17;
     steps[0].tenons = {{"piece-01", 0, 17}, {"piece-01", 2, 17}};
-    steps[1].pieces = {"piece-00", "piece-02"};
-    steps[1].glue = {{"piece-00", "piece-02", 2}};
+    steps[1].pieces = {"piece-00", "piece-02", "piece-03"};
+    steps[1].glue = {{"piece-00", "piece-02", 2}, {"piece-00", "piece-03", 0}};
     steps[1].hole = 17;
     steps[1].tenons = {{"piece-00", 1, 17}};
     const AssemblyGuide g = assemblyGuide(cube, steps);
@@ -113,7 +113,9 @@ TEST_CASE("assembly_guide: the mounting steps, in order, and their checks") {
     CHECK(md.find("### Step 1: piece-01") != std::string::npos);
     CHECK(md.find("Approach from: straight down. Push: straight up") != std::string::npos);
     CHECK(md.find("the blue hole pointing straight down (17) of ball-0, ball-2.") != std::string::npos);
-    CHECK(md.find("### Step 2: piece-00 + piece-02") != std::string::npos);
+    CHECK(md.find("### Step 2: piece-00 + piece-02 + piece-03") != std::string::npos);
+    CHECK(md.find("First glue piece-00 to piece-03 along their common cut face (no room for alignment pins: "
+                  "line the two up by eye)") != std::string::npos);
     CHECK(md.find("First glue piece-00 to piece-02 along their common cut face (2 alignment pins)") !=
           std::string::npos);
     CHECK(md.find("Blue") != std::string::npos);  // the parts table

@@ -137,7 +137,9 @@ std::string mountingMarkdown(const std::vector<MountingStep>& mounting) {
         md += "\n### Step " + std::to_string(s + 1) + ": " + names + "\n\n";
         for (const GlueJoint& g : step.glue)
             md += "- First glue " + g.a + " to " + g.b + " along their common cut face (" +
-                  std::to_string(g.pins) + " alignment pin" + (g.pins == 1 ? "" : "s") + ").\n";
+                  (g.pins == 0 ? std::string("no room for alignment pins: line the two up by eye")
+                               : std::to_string(g.pins) + " alignment pin" + (g.pins == 1 ? "" : "s")) +
+                  ").\n";
         md += "- Approach from: " + zome::directionName(d) +
               ". Push: " + zome::directionName(scale(d, -1.0)) +
               formatNumbers(" (direction %+.3f, %+.3f, %+.3f).\n", 0.0 - d[0], 0.0 - d[1], 0.0 - d[2]);
