@@ -18,13 +18,20 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// The shell grid: --grid, else the one named "shell", else the first.
+/// The shell grid: --grid, else the one named "shell", else the first; it must be a shell (a wall
+/// thickness in its metadata): cutting the solid object would print it solid.
 const sdf::LevelSet& shellGrid(const std::vector<sdf::LevelSet>& grids, std::string name,
                                const std::string& path) {
     if (name.empty())
         for (const sdf::LevelSet& g : grids)
             if (g.info().name == "shell") name = "shell";
-    return sdf::findLevelSet(grids, name, path);
+    const sdf::LevelSet& grid = sdf::findLevelSet(grids, name, path);
+    if (!(grid.info().shellMm > 0))
+        throw Error(
+            ErrorCode::InvalidInput,
+            "grid \"" + grid.info().name + "\" is not a shell (no wall thickness): give zf-shell's output",
+            path);
+    return grid;
 }
 
 /// Cuts, with errors attributed: input mismatches are between the files, a piece that fits
