@@ -106,26 +106,36 @@ void DepthRaster::addPoint(const Vec3d& p, double radiusMm, uint32_t id) {
         }
 }
 
-void DepthRaster::addSphere(const Vec3d& c, double radiusMm, double growMm, uint32_t id) {
-    const double R = (radiusMm + growMm) / mPixel, x = px(c), y = py(c), depth = dot(c, mAxes.d);
+namespace {
+
+/// Calls @p f(i, j, halfMm) for every pixel of a width × height raster that a sphere of radius
+/// @p R pixels, centred over pixel coordinates (x, y), covers: halfMm is half the sphere's
+/// thickness at the pixel's point nearest to the centre's projection (where it is thickest).
+template <class F>
+void forEachSpherePixel(int width, int height, double x, double y, double R, double pixelMm, F&& f) {
     const double halfDiagonal = std::sqrt(0.5);
     for (int j = std::max(0, int(std::floor(y - R - 1)));
-         j <= std::min(mHeight - 1, int(std::floor(y + R + 1))); ++j)
+         j <= std::min(height - 1, int(std::floor(y + R + 1))); ++j)
         for (int i = std::max(0, int(std::floor(x - R - 1)));
-             i <= std::min(mWidth - 1, int(std::floor(x + R + 1))); ++i) {
-            // The pixel's point nearest to the centre's projection: the sphere is thickest there.
+             i <= std::min(width - 1, int(std::floor(x + R + 1))); ++i) {
             const double rho = std::max(0.0, std::hypot(i + 0.5 - x, j + 0.5 - y) - halfDiagonal);
-            if (rho > R) continue;
-            const double half = std::sqrt(R * R - rho * rho) * mPixel;
-            put(i, j, mKeepMax ? depth + half : depth - half, id);
+            if (rho <= R) f(i, j, std::sqrt(R * R - rho * rho) * pixelMm);
         }
+}
+
+}  // namespace
+
+void DepthRaster::addSphere(const Vec3d& c, double radiusMm, double growMm, uint32_t id) {
+    const double depth = dot(c, mAxes.d);
+    forEachSpherePixel(
+        mWidth, mHeight, px(c), py(c), (radiusMm + growMm) / mPixel, mPixel,
+        [&](int i, int j, double half) { put(i, j, mKeepMax ? depth + half : depth - half, id); });
 }
 
 void DepthRaster::addBallWithHole(const Vec3d& c, double radiusMm,
                                   const std::vector<std::array<double, 2>>& hole, double floorDepth,
                                   uint32_t id) {
-    const double R = radiusMm / mPixel, x = px(c), y = py(c), depth = dot(c, mAxes.d);
-    const double halfDiagonal = std::sqrt(0.5);
+    const double depth = dot(c, mAxes.d);
     auto isInHole = [&](double u, double v) {
         const size_t n = hole.size();
         if (n < 3) return false;
@@ -142,16 +152,13 @@ void DepthRaster::addBallWithHole(const Vec3d& c, double radiusMm,
         }
         return true;
     };
-    for (int j = std::max(0, int(std::floor(y - R - 1)));
-         j <= std::min(mHeight - 1, int(std::floor(y + R + 1))); ++j)
-        for (int i = std::max(0, int(std::floor(x - R - 1)));
-             i <= std::min(mWidth - 1, int(std::floor(x + R + 1))); ++i) {
-            const double rho = std::max(0.0, std::hypot(i + 0.5 - x, j + 0.5 - y) - halfDiagonal);
-            if (rho > R) continue;
-            double far = depth + std::sqrt(R * R - rho * rho) * mPixel;
-            if (isInHole(mU0 + mPixel * (i + 0.5), mV0 + mPixel * (j + 0.5))) far = std::min(far, floorDepth);
-            put(i, j, far, id);
-        }
+    forEachSpherePixel(mWidth, mHeight, px(c), py(c), radiusMm / mPixel, mPixel,
+                       [&](int i, int j, double half) {
+                           double far = depth + half;
+                           if (isInHole(mU0 + mPixel * (i + 0.5), mV0 + mPixel * (j + 0.5)))
+                               far = std::min(far, floorDepth);
+                           put(i, j, far, id);
+                       });
 }
 
 void DepthRaster::addCapsule(const Vec3d& a, const Vec3d& b, double radiusMm, double growMm, uint32_t id) {
