@@ -282,28 +282,44 @@ Box3d tenonBoundsMm(const Tenon& t, const TenonOptions& o) {
 }
 
 std::string tenonObstruction(const zome::Structure& frame, const Tenon& t, const TenonOptions& o) {
-    // The prism as a capsule around its axis, in the frame's mm (the exact hole direction).
+    // The tapered stem, in the frame's mm (the exact hole direction), as a chain of short capsules,
+    // each with the radius of its wider end. Only struts and balls near the whole stem (taken at
+    // its widest) can touch one of them: those are found once.
     const zome::Ball& ball = frame.ball(t.ball);
-    // The tapered stem as a chain of short capsules, each with the radius of its wider end.
     const double stepMm = 2.0, lengthMm = t.endMm - t.shoulderMm;
+    auto stemRadius = [&](double fromFaceMm) {
+        return std::sqrt(2.0) * stemHalfWidthMm(o, fromFaceMm) + o.frameClearanceMm;
+    };
+    const Vec3d start = madd(ball.positionMm, t.shoulderMm, t.axisFrame);
+    const Vec3d end = madd(ball.positionMm, t.endMm, t.axisFrame);
+    const double widest = stemRadius(lengthMm), ballR = frame.scale().ballRadiusMm();
+    std::vector<zome::StrutId> nearStruts;
+    for (zome::StrutId id : frame.strutIds()) {
+        const zome::Strut& s = frame.strut(id);
+        const double limit = widest + frame.scale().strutRadiusMm(s.color);
+        if (zome::segmentSegmentDistanceSq(start, end, s.startMm, s.endMm) < limit * limit)
+            nearStruts.push_back(id);
+    }
+    std::vector<zome::BallId> nearBalls;
+    for (zome::BallId id : frame.ballIds())
+        if (id != t.ball && zome::pointSegmentDistanceSq(frame.ball(id).positionMm, start, end) <
+                                (widest + ballR) * (widest + ballR))
+            nearBalls.push_back(id);
     for (double from = 0; from < lengthMm; from += stepMm) {
         const double to = std::min(lengthMm, from + stepMm);
         const Vec3d a = madd(ball.positionMm, t.shoulderMm + from, t.axisFrame);
         const Vec3d b = madd(ball.positionMm, t.shoulderMm + to, t.axisFrame);
-        const double r = std::sqrt(2.0) * stemHalfWidthMm(o, to) + o.frameClearanceMm;
-        for (zome::StrutId id : frame.strutIds()) {
+        const double r = stemRadius(to);
+        for (zome::StrutId id : nearStruts) {
             const zome::Strut& s = frame.strut(id);
             const double limit = r + frame.scale().strutRadiusMm(s.color);
             if (zome::segmentSegmentDistanceSq(a, b, s.startMm, s.endMm) < limit * limit)
                 return "strut " + std::to_string(id) + " (" + zome::partName(s.color, s.size) +
                        ") in the way";
         }
-        const double ballLimit = r + frame.scale().ballRadiusMm();
-        for (zome::BallId id : frame.ballIds()) {
-            if (id == t.ball) continue;
-            if (zome::pointSegmentDistanceSq(frame.ball(id).positionMm, a, b) < ballLimit * ballLimit)
+        for (zome::BallId id : nearBalls)
+            if (zome::pointSegmentDistanceSq(frame.ball(id).positionMm, a, b) < (r + ballR) * (r + ballR))
                 return "ball " + std::to_string(id) + " in the way";
-        }
     }
     return {};
 }
