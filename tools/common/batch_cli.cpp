@@ -21,11 +21,12 @@ batch::WorkerCommand workerCommand(const Tool& tool) {
 
 void BatchCli::addTo(CLI::App& app) {
     app.add_option("manifest", manifest, "Batch manifest (docs/batch.md)")->required();
-    app.add_option("-o,--output", outDir, "Directory for one output directory per entry and the summary")
-        ->required();
+    app.add_option("-o,--output", outDir, "Directory for one output directory per entry and the summary");
     app.add_option("--index", index, "Run entry I alone (for Slurm job arrays or GNU parallel)")
         ->check(CLI::NonNegativeNumber);
     app.add_flag("--merge", isMergeOnly, "Only join the per-entry summaries already in the output directory");
+    app.add_flag("--count", isCountOnly,
+                 "Only check the manifest and print its number of entries on stdout (a job array's size)");
 }
 
 int BatchCli::execute(Tool& tool, nlohmann::json& report) const {
@@ -37,6 +38,11 @@ int BatchCli::execute(Tool& tool, nlohmann::json& report) const {
             throw Error(ErrorCode::InvalidInput, "entry " + std::to_string(i) + ": " + e.message(), manifest);
         }
     }
+    if (isCountOnly) {
+        std::cout << entries.size() << '\n';
+        return 0;
+    }
+    if (outDir.empty()) throw Error(ErrorCode::Usage, "batch needs -o,--output DIR");
     std::error_code ec;
     std::filesystem::create_directories(outDir, ec);
     if (!std::filesystem::is_directory(outDir))

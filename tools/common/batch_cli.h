@@ -19,10 +19,12 @@ struct BatchCli {
     std::string manifest, outDir;
     int index = -1;
     bool isMergeOnly = false;
+    bool isCountOnly = false;  ///< print the number of entries on stdout (for job-array ranges)
 
     void addTo(CLI::App& app);
     /// Checks every entry's options as `zomefab run` would (exit 2 naming the entry), then runs one
-    /// entry (--index), all of them, or only the merge. Exit 0 when every entry succeeded, else 3.
+    /// entry (--index), all of them, or only the merge; --count prints the number of entries. Exit 0 when
+    /// every entry succeeded, else 3.
     int execute(Tool& tool, nlohmann::json& report) const;
 };
 

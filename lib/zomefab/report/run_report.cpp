@@ -224,7 +224,9 @@ RunSummary runSummaryFromJson(const json& report) {
     const json frame = report.value("frame", json::object());
     s.balls = frame.value("balls", size_t(0));
     s.struts = frame.value("struts", size_t(0));
-    s.pieces = report.value("partition", json::object()).value("pieces", size_t(0));
+    // The printed pieces, after the pieces stage's re-cuts (the partition's regions can be fewer).
+    const json pieces = report.value("pieces", json::object());
+    s.pieces = pieces.is_object() ? pieces.value("count", size_t(0)) : 0;
     const json cost = report.value("cost", json::object());
     if (cost.contains("material_saved_hollow_percent") && cost["material_saved_hollow_percent"].is_number()) {
         s.hasMaterialSaved = true;
