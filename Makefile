@@ -5,12 +5,14 @@ BUILD_DIR ?= build
 JOBS      ?= $(shell nproc)
 DEMO_DIR  ?= out/demo
 
-# Libraries the build needs.
+# Libraries the build needs (libjs-three: three.js, inlined into viewer.html at build time).
 BUILD_PACKAGES := cmake g++ make libopenvdb-dev libtbb-dev libeigen3-dev libdraco-dev libtinygltf-dev \
-                  libstb-dev libboost-iostreams-dev doctest-dev libmaxflow-dev liblinear-dev libcli11-dev nlohmann-json3-dev zlib1g-dev
+                  libstb-dev libboost-iostreams-dev doctest-dev libmaxflow-dev liblinear-dev libcli11-dev nlohmann-json3-dev zlib1g-dev \
+                  libjs-three
 # Real checkers the tests run on the outputs: admesh (STL manifold check), draco_decoder, prusa-slicer;
-# and what the batch tests run the docs' recipes on: a single-node Slurm (slurm-wlm, munge), GNU parallel.
-TEST_PACKAGES  := admesh draco prusa-slicer slurm-wlm munge parallel
+# what the batch tests run the docs' recipes on: a single-node Slurm (slurm-wlm, munge), GNU parallel;
+# chromium (headless) opens viewer.html offline and screenshots it.
+TEST_PACKAGES  := admesh draco prusa-slicer slurm-wlm munge parallel chromium
 # The Khronos glTF-Validator (npm), installed once into $(BUILD_DIR)/node; the GLB tests run it with node.
 GLTF_VALIDATOR := gltf-validator@2.0.0-dev.3.10
 

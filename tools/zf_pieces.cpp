@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-/// @file zf-pieces: SHELL.vdb FRAME.json PARTITION.json -> DIR/ with piece-NN.stl, pieces.3mf and
+/// @file zf-pieces: SHELL.vdb FRAME.json PARTITION.json -> DIR/ with piece-NN.stl, plates/plate-NN.3mf and
 /// pieces.json (paper §6, docs/pieces.md). Parse, read, call makePieces, write.
 #include <filesystem>
 
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
     app.add_option("shell", shellPath, "SHELL.vdb from zf-shell (- reads stdin)")->required();
     app.add_option("frame", framePath, "FRAME.json from zf-frame")->required();
     app.add_option("partition", partitionPath, "PARTITION.json from zf-partition")->required();
-    app.add_option("-o,--output", output, "Output directory (piece-NN.stl, pieces.3mf, pieces.json)")
+    app.add_option("-o,--output", output, "Output directory (piece-NN.stl, plates/plate-NN.3mf, pieces.json)")
         ->required();
     app.add_option("--grid", gridName, "Level set to cut (default: \"shell\" if present, else the first)");
     fabricationCli.addTo(app, cli::kPrinter);

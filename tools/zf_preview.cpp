@@ -15,6 +15,7 @@
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/pieces/pieces_io.h"
 #include "zomefab/report/run_report.h"
+#include "zomefab/report/viewer_page.h"
 
 using namespace zomefab;
 namespace fs = std::filesystem;
@@ -45,7 +46,7 @@ void readMeshDirectory(const std::string& path, std::vector<TriMesh>& meshes,
 int main(int argc, char** argv) {
     cli::Tool tool("zf-preview", "Write the preview.glb of a frame and, optionally, its printed pieces");
     CLI::App& app = tool.app();
-    std::string framePath, piecesPath, objectPath, output;
+    std::string framePath, piecesPath, objectPath, output, viewer;
     cli::ScaleCli scaleCli;
     cli::PreviewCli previewCli;
     app.add_option("frame", framePath, "Frame file (zomefab.structure JSON, - = stdin)")->required();
@@ -54,6 +55,7 @@ int main(int argc, char** argv) {
     app.add_option("--object", objectPath,
                    "The input mesh, to name it and its size in the scene (with --height-mm, --up)");
     app.add_option("-o,--output", output, "Output .glb (- = stdout)")->required();
+    app.add_option("--viewer", viewer, "Also write this viewer.html: the scene in a page that opens offline");
     scaleCli.addTo(app);
     previewCli.addTo(app);
 
@@ -82,12 +84,14 @@ int main(int argc, char** argv) {
                     mesh::validateClosedMesh(readMesh(objectPath), {}, objectPath, tool.context()), scale)
                     .sizeMm);
         const std::string glb = serializeGlb(report::buildPreviewScene(input, options), options.glb);
+        if (!viewer.empty()) report::writeViewer(input, options, viewer);  // first: a failure leaves no GLB
         writeOutputAtomic(output,
                           [&](std::ostream& out) { out.write(glb.data(), std::streamsize(glb.size())); });
 
         report = {{"frame", framePath},         {"pieces", input.pieces.size()},
                   {"balls", frame.ballCount()}, {"struts", frame.strutCount()},
                   {"output", output},           {"bytes", glb.size()}};
+        if (!viewer.empty()) report["viewer"] = viewer;
         cli::printInfo(tool, framePath + ": " + std::to_string(frame.ballCount()) + " balls, " +
                                  std::to_string(frame.strutCount()) + " struts, " +
                                  std::to_string(input.pieces.size()) + " pieces -> " + output +

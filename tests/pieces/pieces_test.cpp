@@ -442,7 +442,7 @@ TEST_CASE("pieces: the same result with 1 and 2 threads, and the written files")
         CHECK(p["orientation"]["transform_mm"].size() == 4);
         for (const nlohmann::json& t : p["tenons"]) CHECK(t["length_mm"].get<double>() > 0);
     }
-    CHECK(readInputBytes(out + "/pieces.3mf").substr(0, 4) == std::string("PK\x03\x04", 4));
+    CHECK(readInputBytes(out + "/plates/plate-01.3mf").substr(0, 4) == std::string("PK\x03\x04", 4));
     // Written again over the earlier output: replaced (it holds a pieces.json).
     writePieces(two, out, info);
     CHECK(readInputBytes(out + "/pieces.json") == piecesToJson(two, info).dump(2) + "\n");

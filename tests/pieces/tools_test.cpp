@@ -86,7 +86,7 @@ TEST_CASE("zf-pieces: one closed STL per piece, pieces.3mf and pieces.json") {
     CHECK(j["options"]["tenons"]["holes"] == "all");
     CHECK(j["installation"]["problems"].empty());
     CHECK(j["installation"]["steps"].size() >= 1);
-    CHECK(test::readFile(r.out("pieces.3mf")).substr(0, 2) == "PK");
+    CHECK(test::readFile(r.out("plates/plate-01.3mf")).substr(0, 2) == "PK");
     const nlohmann::json report = nlohmann::json::parse(test::readFile(r.dir.file("report.json")));
     CHECK(report["pieces"] == 4);
     CHECK(report["tool"] == "zf-pieces");
@@ -115,13 +115,16 @@ TEST_CASE("zf-pieces: the same bytes with 1 and 2 threads") {
     REQUIRE(r.runInto("one-thread", "--threads 1") == 0);
     const std::string other = r.dir.file("one-thread");
     size_t files = 0;
-    for (const auto& e : fs::directory_iterator(r.dir.file("out"))) {
+    for (const auto& e : fs::recursive_directory_iterator(r.dir.file("out"))) {
+        if (!e.is_regular_file()) continue;
         ++files;
-        INFO(e.path().filename().string());
-        CHECK(test::readFile(e.path().string()) ==
-              test::readFile(other + "/" + e.path().filename().string()));
+        const std::string name = fs::relative(e.path(), r.dir.file("out")).string();
+        INFO(name);
+        CHECK(test::readFile(e.path().string()) == test::readFile(other + "/" + name));
     }
-    CHECK(files == 7);  // 4 STL, 3MF, JSON and the output manifest
+    const size_t plates = size_t(std::distance(fs::directory_iterator(r.out("plates")), {}));
+    CHECK(plates >= 1);
+    CHECK(files == 4 + plates + 2);  // 4 STL, the plates, JSON and the output manifest
 }
 
 TEST_CASE("zf-pieces: admesh loads every piece with no errors and nothing to repair") {
@@ -165,9 +168,12 @@ TEST_CASE("zf-pieces: PrusaSlicer slices a piece and loads the 3MF") {
     CHECK(code == 0);
     CHECK(test::readFile(gcode).find("; estimated printing time") != std::string::npos);
 
-    REQUIRE(test::runShell("prusa-slicer --loglevel 1 --info " + r.out("pieces.3mf") + " > " +
-                           r.dir.file("info.txt") + " 2>&1") == 0);
-    const std::string info = test::readFile(r.dir.file("info.txt"));
+    std::string info;  // every plate's objects
+    for (const fs::directory_entry& plate : fs::directory_iterator(r.out("plates"))) {
+        REQUIRE(test::runShell("prusa-slicer --loglevel 1 --info " + plate.path().string() + " > " +
+                               r.dir.file("info.txt") + " 2>&1") == 0);
+        info += test::readFile(r.dir.file("info.txt"));
+    }
     INFO(info);
     size_t manifold = 0;
     for (size_t at = info.find("manifold = yes"); at != std::string::npos;

@@ -7,6 +7,7 @@
 /// skipped with a message when they are not installed (`make test-deps` installs them).
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -15,9 +16,11 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
+#include <sstream>
 
 #include "glb_test_util.h"
 #include "test_util.h"
+#include "zomefab/core/format.h"
 #include "zomefab/io/file_io.h"
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/mesh/mesh_check.h"
@@ -71,12 +74,12 @@ json partsJson(const zome::PartsList& parts) { return zome::partsListToJson(part
 
 TEST_CASE("long: every output of the 400 mm run is present") {
     const DemoRun& d = demo();
-    for (const char* name : {"frame.json", "frame.vef", "partition.json", "pieces/pieces.json", "pieces.3mf",
-                             "preview.glb", "assembly.md", "cost.md", "report.json"}) {
+    for (const char* name : {"frame.json", "frame.vef", "partition.json", "pieces/pieces.json",
+                             "plates/plate-01.3mf", "preview.glb", "assembly.md", "cost.md", "report.json"}) {
         INFO(name);
         CHECK(fs::file_size(d.file(name)) > 0);
     }
-    CHECK(readInputBytes(d.file("pieces.3mf")).substr(0, 2) == "PK");
+    CHECK(readInputBytes(d.file("plates/plate-01.3mf")).substr(0, 2) == "PK");
     // report.json is the run's report plus the verifier's verdict on the files as written.
     json written = json::parse(readInputBytes(d.file("report.json")));
     CHECK(written["verify"]["passed"] == true);
@@ -194,6 +197,66 @@ TEST_CASE("long: preview.glb passes the Khronos validator and its Draco pieces d
     const json v = test::khronosValidate(d.file("preview.glb"));
     INFO(v.dump());
     CHECK(v["errors"] == 0);
+}
+
+/// The X and Y extents of every move of a G-code file: {minX, maxX, minY, maxY}.
+static std::array<double, 4> gcodeExtents(const std::string& gcode) {
+    std::array<double, 4> e{1e300, -1e300, 1e300, -1e300};
+    std::istringstream lines(gcode);
+    std::string line;
+    const std::regex axis(R"(\b([XY])(-?[0-9.]+))");
+    while (std::getline(lines, line)) {
+        if (line.rfind("G1 ", 0) != 0 && line.rfind("G0 ", 0) != 0) continue;
+        const std::string code = line.substr(0, line.find(';'));
+        for (auto it = std::sregex_iterator(code.begin(), code.end(), axis); it != std::sregex_iterator();
+             ++it) {
+            const double v = std::stod((*it)[2]);
+            const size_t k = (*it)[1] == "X" ? 0 : 2;
+            e[k] = std::min(e[k], v);
+            e[k + 1] = std::max(e[k + 1], v);
+        }
+    }
+    return e;
+}
+
+TEST_CASE("long: every plate slices on the printer's bed as it is and stays inside it") {
+    if (!report::isSlicerAvailable()) {
+        MESSAGE("prusa-slicer is not installed: skipped");
+        return;
+    }
+    const DemoRun& d = demo();
+    const Vec3d bed = d.options.fabrication.printerMm;
+    std::map<std::string, int> placed;
+    for (const json& plate : d.report["plates"]) {
+        const std::string file = d.file(plate["file"].get<std::string>());
+        INFO(file);
+        for (const json& item : plate["pieces"]) ++placed[item["piece"].get<std::string>()];
+        // --dont-arrange: the slicer takes the plate's placement as it is (it would otherwise move
+        // the objects itself), so the G-code shows where the file put them.
+        test::ScratchDir dir("zomefab-plate");
+        const std::string gcode = dir.file("plate.gcode");
+        const std::string command = formatNumbers(
+            "prusa-slicer --loglevel 1 --export-gcode --dont-arrange --layer-height 0.3 "
+            "--first-layer-height 0.3 --fill-density 10%% --perimeters 2 --gcode-flavor marlin2 "
+            "--bed-shape 0x0,%gx0,%gx%g,0x%g --max-print-height %g",
+            bed[0], bed[0], bed[1], bed[1], bed[2]);
+        std::string log;
+        const int code = test::runCapture(command + " -o " + gcode + " " + file + " 2>&1", &log);
+        INFO(log);
+        REQUIRE(code == 0);
+        const std::array<double, 4> e = gcodeExtents(readInputBytes(gcode));
+        MESSAGE(plate["file"].get<std::string>()
+                << ": X " << e[0] << " … " << e[1] << ", Y " << e[2] << " … " << e[3] << " mm");
+        CHECK(e[0] >= 0.0);
+        CHECK(e[1] <= bed[0]);
+        CHECK(e[2] >= 0.0);
+        CHECK(e[3] <= bed[1]);
+        CHECK(e[1] > e[0]);
+    }
+    // Every piece on exactly one plate.
+    CHECK(placed.size() == d.result.pieces.pieces.size());
+    for (size_t i = 0; i < d.result.pieces.pieces.size(); ++i)
+        CHECK(placed[pieces::pieceName(d.result.pieces, i)] == 1);
 }
 
 TEST_CASE("long: the estimator agrees with PrusaSlicer within 15 % on the pieces and the baseline") {

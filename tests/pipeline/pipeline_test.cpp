@@ -53,9 +53,11 @@ TEST_CASE("pipeline: the small bunny end to end, outputs consistent with each ot
     const std::vector<std::string>& files = outputs.files;
     for (const std::string& f : files) CHECK(fs::exists(fs::path(out) / f));
     CHECK(files == std::vector<std::string>{"assembly.md", "cost.md", "frame.json", "frame.vef",
-                                            "partition.json", "pieces.3mf", "pieces/", "preview.glb",
-                                            "report.json"});
-    CHECK(!fs::exists(out + "/pieces/pieces.3mf"));  // moved up, next to the preview
+                                            "partition.json", "pieces/", "plates/", "preview.glb",
+                                            "report.json", "viewer.html"});
+    CHECK(!fs::exists(out + "/pieces/plates"));  // moved up, next to the preview
+    CHECK(fs::exists(out + "/" + pieces::plateFileName(0)));
+    CHECK(report["plates"].size() == result.plates.size());
     // The cost report prices exactly the pieces written and the frame's parts.
     CHECK(report["cost"]["pieces"] == result.pieces.pieces.size());
     CHECK(report["cost"]["pieces_volume_mm3"].get<double>() ==

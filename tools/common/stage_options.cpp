@@ -84,6 +84,9 @@ void FabricationCli::addTo(CLI::App& app, unsigned parts) {
         app.add_option("--fit-margin-mm", f.fitMarginMm,
                        "Grow each side of a piece's box by this before the fit test")
             ->capture_default_str();
+        app.add_option("--bed-margin-mm", f.bedMarginMm,
+                       "Free border on every side of the bed when the pieces are laid out on plates")
+            ->capture_default_str();
     }
     if (parts & kWall)
         app.add_option("--shell-mm", f.wallMm,

@@ -40,7 +40,7 @@ partition::PartitionFile readPartition(const std::string& path);
 
 /// Which parts of the Fabrication a tool takes on its command line.
 enum FabricationPart : unsigned {
-    kPrinter = 1u << 0,         ///< --printer-mm, --fit-margin-mm
+    kPrinter = 1u << 0,         ///< --printer-mm, --fit-margin-mm, --bed-margin-mm
     kWall = 1u << 1,            ///< --shell-mm
     kFrameClearance = 1u << 2,  ///< --frame-clearance-mm, --b0-mm
     kAllFabrication = kPrinter | kWall | kFrameClearance,

@@ -36,6 +36,7 @@ void checkFabrication(const Fabrication& f) {
                         "--printer-mm: every side must be in (0, 10000] mm, got " +
                             formatNumbers("%g x %g x %g", f.printerMm[0], f.printerMm[1], f.printerMm[2]));
     requireRange(f.fitMarginMm, 0.0, 100.0, "--fit-margin-mm", "mm");
+    requireRange(f.bedMarginMm, 0.0, 100.0, "--bed-margin-mm", "mm");
     requireRange(f.wallMm, 1.0, 200.0, "--shell-mm", "mm");
     requireRange(f.frameClearanceMm, 0.0, 1000.0, "--frame-clearance-mm", "mm");
     requireRange(f.wallGapMm, 0.0, 100.0, "--wall-gap-mm", "mm");

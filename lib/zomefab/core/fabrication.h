@@ -18,6 +18,9 @@ struct Fabrication {
     /// Every side of a piece's oriented box is grown by this much before the partition's fit test,
     /// for the wall behind the surface and the tenons (mm).
     double fitMarginMm = 2.0;
+    /// Free border kept on every side of the printer's bed when the pieces are laid out on plates,
+    /// mm (a piece too large for it goes alone on a plate, centred).
+    double bedMarginMm = 5.0;
     /// Thickness of the printed shell's wall, mm (paper §6: the wall equals its d_min, 16 mm).
     /// Thinner walls (`--shell-mm 4`) print faster and the tenons' tapered stems bridge the gap
     /// to the frame, but on thin meshes fewer pieces then get two tenons (docs/pieces.md).

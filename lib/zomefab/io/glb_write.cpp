@@ -380,4 +380,19 @@ void writeGlb(const GlbScene& scene, const std::string& path, const GlbWriteOpti
                       [&](std::ostream& out) { out.write(bytes.data(), std::streamsize(bytes.size())); });
 }
 
+std::string base64Encode(const std::string& bytes) {
+    static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    out.reserve((bytes.size() + 2) / 3 * 4);
+    for (size_t i = 0; i < bytes.size(); i += 3) {
+        // Three bytes make four 6-bit digits; a short last group is padded with '='.
+        const size_t n = std::min<size_t>(3, bytes.size() - i);
+        uint32_t group = uint32_t(uint8_t(bytes[i])) << 16;
+        if (n > 1) group |= uint32_t(uint8_t(bytes[i + 1])) << 8;
+        if (n > 2) group |= uint32_t(uint8_t(bytes[i + 2]));
+        for (size_t k = 0; k < 4; ++k) out += k <= n ? kAlphabet[(group >> (18 - 6 * k)) & 63] : '=';
+    }
+    return out;
+}
+
 }  // namespace zomefab

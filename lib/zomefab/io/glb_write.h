@@ -78,6 +78,9 @@ struct GlbWriteOptions {
 ///   more than 2^32 bytes) naming the mesh or node; Error(ProcessingFailed) when Draco fails.
 std::string serializeGlb(const GlbScene& scene, const GlbWriteOptions& options = {});
 
+/// @p bytes in base64 (RFC 4648, with padding), e.g. to inline a GLB in a web page.
+std::string base64Encode(const std::string& bytes);
+
 /// serializeGlb() written atomically to @p path ("-" = stdout).
 /// @throw as serializeGlb(), Error(WriteFailed) naming the file.
 void writeGlb(const GlbScene& scene, const std::string& path, const GlbWriteOptions& options = {});

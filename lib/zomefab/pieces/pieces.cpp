@@ -185,6 +185,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
     Pieces out;
     out.options = optionsForVoxel(options, voxel, context);
     out.printerMm = fabrication.printerMm;
+    out.bedMarginMm = fabrication.bedMarginMm;
     out.voxelMm = voxel;
     out.frameToGridMm = frameToGridMm;
     out.gridTransformMm = shellSet.info().transformMm;

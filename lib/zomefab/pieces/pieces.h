@@ -121,6 +121,7 @@ struct Piece {
 struct Pieces {
     std::vector<Piece> pieces;
     Vec3d printerMm = Fabrication{}.printerMm;  ///< the Fabrication's printer they were oriented for
+    double bedMarginMm = Fabrication{}.bedMarginMm;  ///< the Fabrication's, for the plates (plates.h)
     double voxelMm = 0.0;
     double shellVolumeMm3 = 0.0;  ///< the shell, counted in voxels
     /// Shell volume in cells no request names (no outer surface there): merged into neighbours.

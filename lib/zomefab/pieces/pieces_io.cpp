@@ -10,7 +10,7 @@
 #include "zomefab/core/version.h"
 #include "zomefab/io/file_io.h"
 #include "zomefab/io/mesh_io.h"
-#include "zomefab/io/threemf.h"
+#include "zomefab/pieces/plates.h"
 #include "zomefab/pieces/detail/box_distance.h"
 #include "zomefab/zome/holes.h"
 
@@ -63,6 +63,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
     j["units"] = "mm";
     j["inputs"] = {{"shell", info.shellFile}, {"frame", info.frameFile}, {"partition", info.partitionFile}};
     j["printer_mm"] = toJson(all.printerMm);
+    j["bed_margin_mm"] = all.bedMarginMm;
     j["voxel_mm"] = all.voxelMm;
     j["grid_transform_mm"] = toJson(all.gridTransformMm);
     j["frame_to_grid_mm"] = toJson(all.frameToGridMm);
@@ -184,19 +185,6 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
     return j;
 }
 
-void writePiecesThreeMf(const Pieces& all, const std::string& path) {
-    std::vector<ThreeMfObject> objects;
-    // The 3MF lays the pieces out on a plate of bed-sized cells, 10 mm apart, row by row.
-    const size_t columns = size_t(std::ceil(std::sqrt(double(std::max<size_t>(all.pieces.size(), 1)))));
-    for (size_t i = 0; i < all.pieces.size(); ++i) {
-        const double dx = double(i % columns) * (all.printerMm[0] + 10.0);
-        const double dy = double(i / columns) * (all.printerMm[1] + 10.0);
-        objects.push_back(
-            {pieceName(all, i), &all.pieces[i].mesh, Transform4d::scaleTranslate(1.0, {dx, dy, 0.0})});
-    }
-    writeThreeMf(objects, generatorString(), path);
-}
-
 void writePieceFiles(const Pieces& all, const std::string& directory, const PiecesJsonInfo& info) {
     for (size_t i = 0; i < all.pieces.size(); ++i)
         writeMesh(all.pieces[i].mesh, directory + "/" + pieceFileName(all, i));
@@ -208,7 +196,7 @@ void writePieceFiles(const Pieces& all, const std::string& directory, const Piec
 void writePieces(const Pieces& all, const std::string& directory, const PiecesJsonInfo& info) {
     StagedDirectory staging(directory);
     writePieceFiles(all, staging.path(), info);
-    writePiecesThreeMf(all, staging.file("pieces.3mf"));
+    writePlates(all, packPlates(all), staging.path());
     staging.commit();
 }
 

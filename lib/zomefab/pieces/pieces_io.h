@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-/// @file The output files of the pieces stage: piece-NN.stl, pieces.3mf and pieces.json
+/// @file The output files of the pieces stage: piece-NN.stl, plates/plate-NN.3mf and pieces.json
 /// (format `zomefab.pieces`, docs/pieces.md), written into a staging directory that is renamed
 /// into place only when everything was written.
 #pragma once
@@ -37,10 +37,7 @@ nlohmann::json piecesToJson(const Pieces& pieces, const PiecesJsonInfo& info);
 /// @throw Error(WriteFailed) naming the file.
 void writePieceFiles(const Pieces& pieces, const std::string& directory, const PiecesJsonInfo& info);
 
-/// All pieces in one 3MF at @p path (one bed-sized cell each, mm), atomically.
-void writePiecesThreeMf(const Pieces& pieces, const std::string& path);
-
-/// zf-pieces' output: writePieceFiles and pieces.3mf into @p directory, through a temporary
+/// zf-pieces' output: writePieceFiles and the plates (plates/plate-NN.3mf, plates.h) into @p directory, through a temporary
 /// sibling that replaces @p directory only when all were written; an existing @p directory is
 /// replaced only when it is empty or an earlier output (it holds a pieces.json).
 /// @throw Error(WriteFailed) naming the directory or file.

@@ -235,6 +235,9 @@ Pieces piecesFromJson(const json& j, const std::string& directory) {
     Pieces out;
     out.printerMm = optionalField(j, "printer_mm", out.printerMm,
                                   [](const json& v) { return vec3FromJson(v, "printer_mm"); });
+    out.bedMarginMm = optionalField(j, "bed_margin_mm", out.bedMarginMm,
+                                    [](const json& v) { return numberFromJson(v, "bed_margin_mm"); });
+    if (!(out.bedMarginMm >= 0.0 && out.bedMarginMm <= 100.0)) fail("bed_margin_mm out of range [0, 100]");
     out.voxelMm =
         optionalField(j, "voxel_mm", 0.0, [](const json& v) { return numberFromJson(v, "voxel_mm"); });
     auto transform = [](const char* key) {

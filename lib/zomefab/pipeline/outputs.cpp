@@ -10,6 +10,7 @@
 #include "zomefab/pieces/pieces_io.h"
 #include "zomefab/pipeline/pipeline.h"
 #include "zomefab/report/run_report.h"
+#include "zomefab/report/viewer_page.h"
 #include "zomefab/zome/structure_json.h"
 
 namespace zomefab::pipeline {
@@ -49,11 +50,14 @@ RunOutputs writeRunOutputs(const report::RunRecord& run, const RunOptions& optio
     pieces::writePieceFiles(run.pieces, staged.file("pieces"),
                             {run.sourceName, "frame.json", "partition.json"});
     written.push_back("pieces/");
-    // The 3MF holds every piece: one file to open in a slicer, next to the preview, not among the STLs.
-    pieces::writePiecesThreeMf(run.pieces, staged.file("pieces.3mf"));
-    written.push_back("pieces.3mf");
+    // One 3MF per printer bed, each a print job as it is: next to the preview, not among the STLs.
+    pieces::writePlates(run.pieces, run.plates, staged.path());
+    written.push_back("plates/");
     report::writePreview(report::previewInput(run), staged.file("preview.glb"), options.preview);
     written.push_back("preview.glb");
+    // The same scene as a page that opens offline (three.js inlined, no Draco decoder needed).
+    report::writeViewer(report::previewInput(run), options.preview, staged.file("viewer.html"));
+    written.push_back("viewer.html");
     write("assembly.md", [&](std::ostream& out) {
         out << report::assemblyGuideMarkdown(run.assembly, options.cost.prices);
     });

@@ -94,6 +94,7 @@ void makePieces(report::RunRecord& run, const RunOptions& options, RunContext& c
                                   run.fabrication, options.pieces, context);
     });
     pieces::requireBuildable(run.pieces);  // exit 3 with the plan's reasons; nothing is written
+    run.plates = pieces::packPlates(run.pieces);
 }
 
 /// Stage 7: what the user reads (paper §7): the assembly guide and the cost report (Table 1).

@@ -56,7 +56,7 @@ struct RunOutputs {
 };
 
 /// Writes every output file of @p run (frame.json, frame.vef, partition.json, pieces/ with
-/// piece-NN.stl and pieces.json, pieces.3mf, preview.glb, assembly.md, cost.md, report.json =
+/// piece-NN.stl and pieces.json, plates/plate-NN.3mf, preview.glb, assembly.md, cost.md, report.json =
 /// @p report, report::runReportJson, with the verifier's findings added as "verify") into a staging
 /// directory, runs the verifier on the files written (docs/mounting.md) and moves the directory
 /// to @p outDir when they pass, else to @p outDir + ".failed" for inspection. A failure to write

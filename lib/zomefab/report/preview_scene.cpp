@@ -20,6 +20,22 @@ namespace zomefab::report {
 
 namespace {
 
+/// @p mesh with its vertices in the order the triangles first use them, bit-identical ones merged:
+/// what reading its STL back gives, so an uncompressed scene has the same bytes whether its pieces
+/// come from memory (`zomefab run`) or from the files (`zf-preview`). Draco orders vertices itself.
+TriMesh inTriangleOrder(const TriMesh& mesh) {
+    TriMesh soup;
+    soup.positions.reserve(mesh.triangles.size() * 3);
+    soup.triangles.reserve(mesh.triangles.size());
+    for (const Triangle& t : mesh.triangles) {
+        const uint32_t first = uint32_t(soup.positions.size());
+        for (const uint32_t v : t) soup.positions.push_back(mesh.positions[v]);
+        soup.triangles.push_back({first, first + 1, first + 2});
+    }
+    weldIdenticalVertices(soup);
+    return soup;
+}
+
 using Mat3 = std::array<Vec3d, 3>;  // columns
 
 /// sRGB component (0..1) to the linear value glTF's baseColorFactor expects (glTF 2.0 §3.9.2).
@@ -191,7 +207,8 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
             scene.materials.push_back(pieceMaterial(i, name));
             GlbMesh mesh;
             mesh.name = name;
-            mesh.geometry = *input.pieces[i];
+            mesh.geometry =
+                options.isPieceDracoCompressed ? *input.pieces[i] : inTriangleOrder(*input.pieces[i]);
             mesh.geometry.salientFaces.clear();
             if (!input.pieceTransforms.empty()) transformInPlace(mesh.geometry, input.pieceTransforms[i]);
             mesh.material = int(scene.materials.size() - 1);

@@ -15,6 +15,7 @@
 #include "zomefab/mesh/scale.h"
 #include "zomefab/partition/partition_result.h"
 #include "zomefab/pieces/pieces.h"
+#include "zomefab/pieces/plates.h"
 #include "zomefab/report/assembly_guide.h"
 #include "zomefab/report/cost_report.h"
 #include "zomefab/sdf/level_set.h"
@@ -40,6 +41,7 @@ struct RunRecord {
     TriMesh surfaceFrameMm;  ///< the scaled surface in the frame's coordinates
     partition::PartitionResult partition;
     pieces::Pieces pieces;             ///< printable pieces, in printer coordinates
+    std::vector<pieces::Plate> plates; ///< the pieces on printer beds, one print job each
     AssemblyGuide assembly;            ///< build order of the frame and the pieces' tenons
     CostReport cost;                   ///< Table 1: ZomeFab against the octree baseline
     std::vector<StageTiming> timings;  ///< in run order

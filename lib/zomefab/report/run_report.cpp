@@ -157,6 +157,7 @@ json runReportJson(const RunRecord& run, const RunContext& context) {
     report["frame"] = frameJson(run);
     report["partition"] = partitionJson(run);
     report["pieces"] = piecesJson(run);
+    report["plates"] = pieces::platesToJson(run.pieces, run.plates);
     report["assembly"] = {{"layers", run.assembly.layers},
                           {"components", run.assembly.components},
                           {"mounting", assemblyGuideToJson(run.assembly)["mounting"]},
