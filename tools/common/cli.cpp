@@ -49,6 +49,7 @@ const char* levelPrefix(LogLevel level) {
     switch (level) {
         case LogLevel::Debug:
             return "debug: ";
+        case LogLevel::Detail:
         case LogLevel::Info:
             return "";
         case LogLevel::Warning:
@@ -97,7 +98,8 @@ int Tool::run(int argc, char** argv, const std::function<int(nlohmann::json&)>& 
     const std::string toolName = mName;
     auto log = [toolName, verbosity](LogLevel level, const std::string& msg) {
         if (level == LogLevel::Debug && verbosity < 2) return;
-        if (level != LogLevel::Debug && verbosity < 0) return;  // -q: errors only
+        if (level == LogLevel::Detail && verbosity < 1) return;  // stage internals: -v
+        if (level != LogLevel::Debug && verbosity < 0) return;   // -q: errors only
         std::cerr << toolName << ": " << levelPrefix(level) << msg << '\n';
     };
     auto stageClock = std::make_shared<Stopwatch>();

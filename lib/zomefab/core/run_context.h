@@ -12,7 +12,10 @@
 
 namespace zomefab {
 
-enum class LogLevel { Debug, Info, Warning };
+/// Debug: for developers (-vv). Detail: how a stage went, its internal numbers (energies, schedule
+/// steps, merges; -v). Info: what the user follows by default (progress, results). Warning: what the
+/// user should act on.
+enum class LogLevel { Debug, Detail, Info, Warning };
 
 class RunContext {
 public:
@@ -25,6 +28,7 @@ public:
         : mLog(std::move(log)), mProgress(std::move(progress)), mCancelFlag(cancelFlag) {}
 
     void debug(const std::string& msg) const { emit(LogLevel::Debug, msg); }
+    void detail(const std::string& msg) const { emit(LogLevel::Detail, msg); }
     void info(const std::string& msg) const { emit(LogLevel::Info, msg); }
     /// Logs a warning and records it, so reports can list everything that was adjusted or skipped.
     void warn(const std::string& msg) const;

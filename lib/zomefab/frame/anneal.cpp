@@ -151,9 +151,9 @@ std::vector<ChainResult> annealChains(const zome::Structure& initial, const Fram
         if (expected > 0) context.progress("anneal", std::min(1.0, double(done) / (expected * chains)));
         double best = HUGE_VAL;
         for (int c = 0; c < chains; ++c) best = std::min(best, current[size_t(c)].load());
-        context.info("anneal: " + std::to_string(done) + " iterations over " + std::to_string(chains) +
-                     " chains (" + std::to_string(finished.load()) + " finished), " +
-                     formatNumbers("T %.3g, best E %.4f", temperature, best));
+        context.detail("anneal: " + std::to_string(done) + " iterations over " + std::to_string(chains) +
+                       " chains (" + std::to_string(finished.load()) + " finished), " +
+                       formatNumbers("T %.3g, best E %.4f", temperature, best));
     };
     tbb::parallel_for(0, chains, [&](int c) {
         Chain chain(initial, field, energy, anneal, chainSeed(seed, c), c);

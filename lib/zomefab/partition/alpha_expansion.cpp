@@ -19,15 +19,19 @@ int64_t LabelingProblem::slotOf(uint32_t u, uint32_t label) const {
 }
 
 void LabelingProblem::validate() const {
-    auto fail = [](const std::string& what) { throw Error(ErrorCode::Internal, "labeling problem: " + what); };
-    if (candidateOffsets.empty() || neighborOffsets.size() != candidateOffsets.size()) fail("offset sizes differ");
+    auto fail = [](const std::string& what) {
+        throw Error(ErrorCode::Internal, "labeling problem: " + what);
+    };
+    if (candidateOffsets.empty() || neighborOffsets.size() != candidateOffsets.size())
+        fail("offset sizes differ");
     if (candidateOffsets.back() != candidateLabels.size() || candidateCosts.size() != candidateLabels.size())
         fail("candidate arrays");
     if (neighborOffsets.back() != neighbors.size() || neighborWeights.size() != neighbors.size())
         fail("neighbour arrays");
     const size_t n = nodeCount();
     for (size_t u = 0; u < n; ++u) {
-        if (candidateOffsets[u + 1] <= candidateOffsets[u]) fail("node " + std::to_string(u) + " has no candidate");
+        if (candidateOffsets[u + 1] <= candidateOffsets[u])
+            fail("node " + std::to_string(u) + " has no candidate");
         for (uint32_t s = candidateOffsets[u]; s < candidateOffsets[u + 1]; ++s) {
             if (candidateLabels[s] >= labelCount) fail("label out of range");
             if (!std::isfinite(candidateCosts[s])) fail("non-finite data cost");
@@ -46,7 +50,8 @@ void LabelingProblem::validate() const {
     }
 }
 
-double labelingEnergy(const LabelingProblem& p, const std::vector<uint32_t>& labels, double smoothnessWeight) {
+double labelingEnergy(const LabelingProblem& p, const std::vector<uint32_t>& labels,
+                      double smoothnessWeight) {
     const size_t n = p.nodeCount();
     double data = 0.0, smooth = 0.0;
     for (size_t u = 0; u < n; ++u) {
@@ -98,7 +103,8 @@ public:
             maxActive = std::max(maxActive, a);
         }
         maxEdges = 2 * maxActive;  // a first guess: the graph grows when needed
-        mGraph = std::make_unique<FlowGraph>(int(std::max<size_t>(maxActive, 16)), int(std::max<size_t>(maxEdges, 16)));
+        mGraph = std::make_unique<FlowGraph>(int(std::max<size_t>(maxActive, 16)),
+                                             int(std::max<size_t>(maxEdges, 16)));
         mNodeOf.assign(n, -1);
         mEnergy = labelingEnergy(p, mLabels, ws);
     }
@@ -222,11 +228,13 @@ private:
 
 }  // namespace
 
-AlphaExpansionResult alphaExpansion(const LabelingProblem& problem, const std::vector<uint32_t>& initialLabels,
+AlphaExpansionResult alphaExpansion(const LabelingProblem& problem,
+                                    const std::vector<uint32_t>& initialLabels,
                                     const AlphaExpansionOptions& options, const RunContext& context) {
     if (initialLabels.size() != problem.nodeCount())
         throw Error(ErrorCode::Usage, "alpha-expansion: " + std::to_string(initialLabels.size()) +
-                                          " initial labels for " + std::to_string(problem.nodeCount()) + " nodes");
+                                          " initial labels for " + std::to_string(problem.nodeCount()) +
+                                          " nodes");
     if (!(options.smoothnessWeight >= 0.0) || !std::isfinite(options.smoothnessWeight))
         throw Error(ErrorCode::Usage, "alpha-expansion: w_smoothness must be finite and >= 0");
     AlphaExpansionResult result;
@@ -255,7 +263,8 @@ AlphaExpansionResult alphaExpansion(const LabelingProblem& problem, const std::v
     }
     if (!result.isConverged) {
         result.isConverged = true;
-        for (char d : dirty) if (d) result.isConverged = false;
+        for (char d : dirty)
+            if (d) result.isConverged = false;
     }
     result.labels = std::move(ex.labels());
     return result;

@@ -251,8 +251,8 @@ void cutAndMakePieces(const Surface& S, Classes& C, const Fabrication& fab, cons
             if (!C.faceGroup.empty())
                 for (uint32_t f : pieceFaces[p]) C.faceGroup[f] = C.groupCount + C.trainClass[f];
         }
-        run.info(std::to_string(tooLarge.size()) +
-                 " piece(s) do not fit the printer after the planar cuts; split and retrain");
+        run.detail(std::to_string(tooLarge.size()) +
+                   " piece(s) do not fit the printer after the planar cuts; split and retrain");
     }
     res.secondsSvm = clock.seconds();
 }

@@ -53,7 +53,8 @@ LinearCells trainLinearCells(const std::vector<Vec3d>& pts, const std::vector<ui
     // Feature scaling: uniform, so the max-margin geometry is the one in millimetres.
     Box3d box;
     for (const Vec3d& p : pts) box.expand(p);
-    const Vec3d c{0.5 * (box.min[0] + box.max[0]), 0.5 * (box.min[1] + box.max[1]), 0.5 * (box.min[2] + box.max[2])};
+    const Vec3d c{0.5 * (box.min[0] + box.max[0]), 0.5 * (box.min[1] + box.max[1]),
+                  0.5 * (box.min[2] + box.max[2])};
     const Vec3d size = box.size();
     const double s = std::max(0.5 * std::max({size[0], size[1], size[2]}), 1e-9);
 
@@ -122,7 +123,8 @@ LinearCells trainLinearCells(const std::vector<Vec3d>& pts, const std::vector<ui
     // Cells in increasing class order, so the numbering does not depend on sample order.
     std::vector<size_t> order(static_cast<size_t>(k));
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return cells.classes[a] < cells.classes[b]; });
+    std::sort(order.begin(), order.end(),
+              [&](size_t a, size_t b) { return cells.classes[a] < cells.classes[b]; });
     LinearCells sorted;
     for (size_t i : order) {
         sorted.w.push_back(cells.w[i]);

@@ -47,7 +47,8 @@ Score scoreOf(const std::vector<Vec3d>& pts, const Mat3& r, const Vec3d& printer
         lo = lo.cwiseMin(q);
         hi = hi.cwiseMax(q);
     }
-    const Vec3d e = sorted3({hi[0] - lo[0] + 2 * margin, hi[1] - lo[1] + 2 * margin, hi[2] - lo[2] + 2 * margin});
+    const Vec3d e =
+        sorted3({hi[0] - lo[0] + 2 * margin, hi[1] - lo[1] + 2 * margin, hi[2] - lo[2] + 2 * margin});
     Score s;
     for (int i = 0; i < 3; ++i) s.ratio = std::max(s.ratio, e[size_t(i)] / printerSorted[size_t(i)]);
     s.volume = e[0] * e[1] * e[2];
@@ -60,8 +61,8 @@ Mat3 rotationAbout(const Eigen::Vector3d& axis, double angleRad) {
 
 }  // namespace
 
-PrinterFit evaluateFit(const std::vector<Vec3d>& pts, const std::array<Vec3d, 3>& axes, const Vec3d& printerMm,
-                       double marginMm) {
+PrinterFit evaluateFit(const std::vector<Vec3d>& pts, const std::array<Vec3d, 3>& axes,
+                       const Vec3d& printerMm, double marginMm) {
     PrinterFit fit;
     if (pts.empty()) {
         fit.fits = true;
@@ -135,7 +136,8 @@ PrinterFit fitInPrinter(const std::vector<Vec3d>& pts, const Vec3d& printerMm, d
     // principal axis onto the box diagonal (1, 1, 1)/√3.
     const Mat3 diagonal =
         Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), Eigen::Vector3d(1, 1, 1).normalized())
-            .toRotationMatrix() * pca;
+            .toRotationMatrix() *
+        pca;
     for (const Mat3& start : {Mat3(Mat3::Identity()), pca, diagonal}) {
         Mat3 r = start;
         Score s = scoreOf(sample, r, printerSorted, marginMm);

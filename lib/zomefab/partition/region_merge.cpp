@@ -44,9 +44,9 @@ void mergeRegions(const Surface& S, const Fabrication& fab, const PartitionOptio
     for (uint32_t f = 0; f < S.faceCount; ++f) C.faceGroup[f] = m.groupOf[regionOf[f]];
     C.groupCount = m.groupCount;
     res.regionMerges = m.merges;
-    run.info(std::to_string(regionCount) + " regions, " + std::to_string(m.merges) +
-             " merged into a neighbour they fit the printer with: " + std::to_string(m.groupCount) +
-             " regions");
+    run.detail(std::to_string(regionCount) + " regions, " + std::to_string(m.merges) +
+               " merged into a neighbour they fit the printer with: " + std::to_string(m.groupCount) +
+               " regions");
     run.debug(formatNumbers("region merge: %.3f s", clock.seconds()));
 }
 

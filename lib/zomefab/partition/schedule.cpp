@@ -183,14 +183,14 @@ void runSchedule(const Surface& S, const Problems& P, const PartitionOptions& op
         res.energyGraphCut = st.energyGraphCut;
         res.sweepEnergies = ae.sweepEnergies;
         res.graphCutPartitions = st.partitions;
-        run.info(formatNumbers("w_smoothness %g: ", ws) +
-                 (isWholeCut ? std::string()
-                             : "re-cut " + std::to_string(st.faces) +
-                                   " faces of the partitions that did not fit, ") +
-                 formatNumbers("E %.6g -> %.6g, %.0f partitions", st.energyNearest, st.energyGraphCut,
-                               double(st.partitions)) +
-                 (oversized.empty() ? ", all fit the printer"
-                                    : ", " + std::to_string(oversized.size()) + " too large"));
+        run.detail(formatNumbers("w_smoothness %g: ", ws) +
+                   (isWholeCut ? std::string()
+                               : "re-cut " + std::to_string(st.faces) +
+                                     " faces of the partitions that did not fit, ") +
+                   formatNumbers("E %.6g -> %.6g, %.0f partitions", st.energyNearest, st.energyGraphCut,
+                                 double(st.partitions)) +
+                   (oversized.empty() ? ", all fit the printer"
+                                      : ", " + std::to_string(oversized.size()) + " too large"));
         if (!ae.isConverged)
             run.warn(formatNumbers("graph cut at w_smoothness %g stopped after %.0f sweeps before converging",
                                    ws, double(ae.sweeps)));

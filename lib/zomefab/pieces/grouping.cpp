@@ -372,9 +372,9 @@ Grouping groupPieces(VoxelField& field, const GridCells& cells, const std::vecto
     const std::vector<uint32_t> cellPieceCount = ownVoxels(field, comps, pieceOfComp, cells.count());
     describePieces(out, comps, pieceOfComp, cellPieceCount, requests.size(), field.voxelMm);
     out.faces = faceContacts(field, cells, out.cellSets, out.pieces);
-    context.info(std::to_string(out.pieces.size()) + " pieces from " + std::to_string(comps.size()) +
-                 " components of " + std::to_string(cells.count()) + " cells (" +
-                 std::to_string(out.sliversMerged) + " slivers merged)");
+    context.detail(std::to_string(out.pieces.size()) + " pieces from " + std::to_string(comps.size()) +
+                   " components of " + std::to_string(cells.count()) + " cells (" +
+                   std::to_string(out.sliversMerged) + " slivers merged)");
     return out;
 }
 

@@ -146,8 +146,8 @@ void meshPieces(Pieces& out, std::vector<PieceGrid>& grids, const GridCells& cel
         context.debug("piece " + std::to_string(p) + ": " + notes[p]);
     }
     if (offCutFace > 0)
-        context.info(std::to_string(offCutFace) + " of " + std::to_string(pieceCount) +
-                     " pieces have no cut face they can lie on; they rest on their largest base that fits");
+        context.detail(std::to_string(offCutFace) + " of " + std::to_string(pieceCount) +
+                       " pieces have no cut face they can lie on; they rest on their largest base that fits");
 }
 
 }  // namespace

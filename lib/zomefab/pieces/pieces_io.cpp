@@ -10,8 +10,8 @@
 #include "zomefab/core/version.h"
 #include "zomefab/io/file_io.h"
 #include "zomefab/io/mesh_io.h"
-#include "zomefab/pieces/plates.h"
 #include "zomefab/pieces/detail/box_distance.h"
+#include "zomefab/pieces/plates.h"
 #include "zomefab/zome/holes.h"
 
 namespace zomefab::pieces {

@@ -80,9 +80,9 @@ size_t recutBlocked(Pieces& out, VoxelField& field, const GridCells& cells, Grou
         const std::optional<SplitPlane> plane = findSplit(voxels, mine, sweeps, search);
         if (!plane) continue;
         const uint32_t q = splitPiece(out.pieces, grouping.cellSets, field, p, *plane);
-        context.info("piece " + std::to_string(p) +
-                     " meets the frame along every direction: re-cut in two (" + std::to_string(p) + " and " +
-                     std::to_string(q) + ")");
+        context.detail("piece " + std::to_string(p) +
+                       " meets the frame along every direction: re-cut in two (" + std::to_string(p) +
+                       " and " + std::to_string(q) + ")");
         ++cut;
     }
     out.recutPieces += cut;
