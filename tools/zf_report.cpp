@@ -25,7 +25,8 @@ int main(int argc, char** argv) {
     app.add_option("frame", framePath, "FRAME.json from zf-frame")->required();
     app.add_option("pieces", piecesPath, "The pieces directory (or its pieces.json) from zf-pieces")
         ->required();
-    app.add_option("-o,--output", outDir, "Directory to write assembly.md and cost.md into (must exist)")
+    app.add_option("-o,--output", outDir,
+                   "Directory to write assembly.md, assembly.html and cost.md into (must exist)")
         ->required();
     scaleCli.addTo(app);
     fabricationCli.addTo(app, cli::kPrinter);
@@ -51,6 +52,8 @@ int main(int argc, char** argv) {
         writeOutputAtomic(outDir + "/assembly.md", [&](std::ostream& out) {
             out << report::assemblyGuideMarkdown(run.assembly, costOptions.prices);
         });
+        writeOutputAtomic(outDir + "/assembly.html",
+                          [&](std::ostream& out) { out << report::assemblyPage(run, costOptions.prices); });
         writeOutputAtomic(outDir + "/cost.md", [&](std::ostream& out) { out << report::costPage(run); });
         report = report::costReportToJson(run.cost);
         for (const std::string& line : report::runSummaryLines(run)) cli::printInfo(tool, line);

@@ -18,6 +18,7 @@
 #include <set>
 #include <sstream>
 
+#include "browser_test_util.h"
 #include "glb_test_util.h"
 #include "test_util.h"
 #include "zomefab/core/format.h"
@@ -74,8 +75,9 @@ json partsJson(const zome::PartsList& parts) { return zome::partsListToJson(part
 
 TEST_CASE("long: every output of the 400 mm run is present") {
     const DemoRun& d = demo();
-    for (const char* name : {"frame.json", "frame.vef", "partition.json", "pieces/pieces.json",
-                             "plates/plate-01.3mf", "preview.glb", "assembly.md", "cost.md", "report.json"}) {
+    for (const char* name :
+         {"frame.json", "frame.vef", "partition.json", "pieces/pieces.json", "plates/plate-01.3mf",
+          "preview.glb", "viewer.html", "assembly.md", "assembly.html", "cost.md", "report.json"}) {
         INFO(name);
         CHECK(fs::file_size(d.file(name)) > 0);
     }
@@ -217,6 +219,43 @@ static std::array<double, 4> gcodeExtents(const std::string& gcode) {
         }
     }
     return e;
+}
+
+TEST_CASE(
+    "long: assembly.html has a picture per frame layer and per mounting step; both pages open offline") {
+    const DemoRun& d = demo();
+    const std::string html = readInputBytes(d.file("assembly.html"));
+    size_t layers = 0, steps = 0;
+    for (size_t at = html.find("<img class=\"step\""); at != std::string::npos;
+         at = html.find("<img class=\"step\"", at + 1)) {
+        const size_t alt = html.find("alt=\"", at) + 5;
+        layers += html.compare(alt, 6, "Layer ") == 0;
+        steps += html.compare(alt, 5, "Step ") == 0;
+        CHECK(html.compare(html.find("src=\"", at) + 5, 22, "data:image/png;base64,") == 0);
+    }
+    size_t guideLayers = 0;  // (component, layer) pairs of the guide
+    for (size_t i = 0; i < d.result.assembly.steps.size(); ++i)
+        guideLayers += i == 0 || d.result.assembly.steps[i].layer != d.result.assembly.steps[i - 1].layer ||
+                       d.result.assembly.steps[i].component != d.result.assembly.steps[i - 1].component;
+    CHECK(layers == guideLayers);
+    CHECK(steps == d.result.assembly.mounting.size());
+    if (!test::hasChromium()) {
+        MESSAGE("chromium is not installed: the browser checks are skipped");
+        return;
+    }
+    // The guide's page is white, the viewer's background #f2f2f2.
+    for (const auto& [page, background] :
+         {std::pair<const char*, int>{"assembly.html", 255}, {"viewer.html", 0xf2}}) {
+        INFO(page);
+        test::ScratchDir dir("zomefab-page");
+        const test::BrowserRun run = test::openInChromium(d.file(page), dir.file("shot.png"));
+        INFO(run.log);
+        CHECK(run.exitCode == 0);
+        CHECK(run.consoleErrors.empty());
+        const test::Image shot = test::readPng(dir.file("shot.png"));
+        const uint8_t bg = uint8_t(background);
+        CHECK(test::countPixelsUnlike(shot, bg, bg, bg, 4, 0, 150) > 20000);
+    }
 }
 
 TEST_CASE("long: every plate slices on the printer's bed as it is and stays inside it") {

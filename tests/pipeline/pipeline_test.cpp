@@ -52,9 +52,9 @@ TEST_CASE("pipeline: the small bunny end to end, outputs consistent with each ot
     CHECK(outputs.directory == out);
     const std::vector<std::string>& files = outputs.files;
     for (const std::string& f : files) CHECK(fs::exists(fs::path(out) / f));
-    CHECK(files == std::vector<std::string>{"assembly.md", "cost.md", "frame.json", "frame.vef",
-                                            "partition.json", "pieces/", "plates/", "preview.glb",
-                                            "report.json", "viewer.html"});
+    CHECK(files == std::vector<std::string>{"assembly.html", "assembly.md", "cost.md", "frame.json",
+                                            "frame.vef", "partition.json", "pieces/", "plates/",
+                                            "preview.glb", "report.json", "viewer.html"});
     CHECK(!fs::exists(out + "/pieces/plates"));  // moved up, next to the preview
     CHECK(fs::exists(out + "/" + pieces::plateFileName(0)));
     CHECK(report["plates"].size() == result.plates.size());

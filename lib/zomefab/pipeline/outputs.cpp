@@ -61,6 +61,7 @@ RunOutputs writeRunOutputs(const report::RunRecord& run, const RunOptions& optio
     write("assembly.md", [&](std::ostream& out) {
         out << report::assemblyGuideMarkdown(run.assembly, options.cost.prices);
     });
+    write("assembly.html", [&](std::ostream& out) { out << report::assemblyPage(run, options.cost.prices); });
     write("cost.md", [&](std::ostream& out) { out << report::costPage(run); });
     // The verifier reads back what was written, as `zomefab check` would.
     RunOutputs result;

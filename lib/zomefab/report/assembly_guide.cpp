@@ -118,37 +118,76 @@ AssemblyGuide assemblyGuide(const zome::Structure& frame, const std::vector<Moun
     return guide;
 }
 
+std::string mountingTitle(const MountingStep& step) {
+    std::string names;
+    for (const std::string& p : step.pieces) names += (names.empty() ? "" : " + ") + p;
+    return names;
+}
+
+std::vector<std::string> mountingSentences(const MountingStep& step) {
+    std::vector<std::string> lines;
+    for (const GlueJoint& g : step.glue)
+        lines.push_back("First glue " + g.a + " to " + g.b + " along their common cut face (" +
+                        (g.pins == 0 ? std::string("no room for alignment pins: line the two up by eye")
+                                     : std::to_string(g.pins) + " alignment pin" + (g.pins == 1 ? "" : "s")) +
+                        ").");
+    const Vec3d& d = zome::holeDirection(step.hole);
+    lines.push_back("Approach from: " + zome::directionName(d) +
+                    ". Push: " + zome::directionName(scale(d, -1.0)) +
+                    formatNumbers(" (direction %+.3f, %+.3f, %+.3f).", 0.0 - d[0], 0.0 - d[1], 0.0 - d[2]));
+    std::string pegs =
+        "Its pegs go into " + holeWords(step.hole) + " (" + std::to_string(step.hole) + ") of ";
+    if (step.tenons.empty()) pegs += "no ball: it is held by the pieces it is glued to";
+    for (size_t i = 0; i < step.tenons.size(); ++i)
+        pegs += (i ? ", " : "") + ballName(step.tenons[i].ball) +
+                (step.pieces.size() > 1 ? " (" + step.tenons[i].piece + ")" : "");
+    lines.push_back(pegs + ".");
+    return lines;
+}
+
+std::string ballHeading(const BallStep& step) {
+    return ballName(step.ball) + " at " +
+           formatNumbers("(%.1f, %.1f, %.1f) mm", step.positionMm[0], step.positionMm[1], step.positionMm[2]);
+}
+
+std::string strutSentence(const StrutStep& s) {
+    return zome::partName(s.color, s.size) + " (" + zome::colorName(s.color) + ") in " + holeWords(s.hole) +
+           " (" + std::to_string(s.hole) + ") to " + ballName(s.toBall) + (s.isNewBall ? " (new)" : "") +
+           ", its hole " + std::to_string(s.toHole);
+}
+
+std::string frameIntroduction() {
+    return "Build the frame ball by ball in the order below: breadth-first from the lowest ball, one layer "
+           "of "
+           "balls at a time, each layer from the bottom up. At each ball, attach the struts listed (the ones "
+           "not "
+           "attached yet); \"new\" means the strut carries a ball that is not in place yet: put a new ball "
+           "on "
+           "its free end. Positions are in millimetres; directions are as you face the model: x to the "
+           "right, "
+           "y away from you, z up. Every ball sits the same way round, so a hole that points straight up on "
+           "one "
+           "ball points straight up on all of them. The number after a hole is zomefab's (blue 0-29, yellow "
+           "30-49, red 50-61).";
+}
+
+std::string mountingIntroduction() {
+    return "With the frame built, put the printed pieces on one at a time, in this order. Each goes on along "
+           "one "
+           "direction, all its pegs at once: hold it on the side it approaches from, pegs toward the frame, "
+           "line "
+           "every peg up with its hole and push it straight in until the pegs are seated (4 mm). Glue a "
+           "group's "
+           "pieces together first, pins into sockets, and let the glue set.";
+}
+
 namespace {
 
 std::string mountingMarkdown(const std::vector<MountingStep>& mounting) {
-    std::string md =
-        "\n## Putting the pieces on\n\nWith the frame built, put the printed pieces on one at a time, in "
-        "this "
-        "order. Each goes on along one direction, all its pegs at once: hold it on the side it approaches "
-        "from, "
-        "pegs toward the frame, line every peg up with its hole and push it straight in until the pegs are "
-        "seated (4 mm). "
-        "Glue a group's pieces together first, pins into sockets, and let the glue set.\n";
+    std::string md = "\n## Putting the pieces on\n\n" + mountingIntroduction() + "\n";
     for (size_t s = 0; s < mounting.size(); ++s) {
-        const MountingStep& step = mounting[s];
-        std::string names;
-        for (const std::string& p : step.pieces) names += (names.empty() ? "" : " + ") + p;
-        const Vec3d& d = zome::holeDirection(step.hole);
-        md += "\n### Step " + std::to_string(s + 1) + ": " + names + "\n\n";
-        for (const GlueJoint& g : step.glue)
-            md += "- First glue " + g.a + " to " + g.b + " along their common cut face (" +
-                  (g.pins == 0 ? std::string("no room for alignment pins: line the two up by eye")
-                               : std::to_string(g.pins) + " alignment pin" + (g.pins == 1 ? "" : "s")) +
-                  ").\n";
-        md += "- Approach from: " + zome::directionName(d) +
-              ". Push: " + zome::directionName(scale(d, -1.0)) +
-              formatNumbers(" (direction %+.3f, %+.3f, %+.3f).\n", 0.0 - d[0], 0.0 - d[1], 0.0 - d[2]);
-        md += "- Its pegs go into " + holeWords(step.hole) + " (" + std::to_string(step.hole) + ") of ";
-        if (step.tenons.empty()) md += "no ball: it is held by the pieces it is glued to";
-        for (size_t i = 0; i < step.tenons.size(); ++i)
-            md += (i ? ", " : "") + ballName(step.tenons[i].ball) +
-                  (step.pieces.size() > 1 ? " (" + step.tenons[i].piece + ")" : "");
-        md += ".\n";
+        md += "\n### Step " + std::to_string(s + 1) + ": " + mountingTitle(mounting[s]) + "\n\n";
+        for (const std::string& line : mountingSentences(mounting[s])) md += "- " + line + "\n";
     }
     return md;
 }
@@ -162,15 +201,7 @@ std::string assemblyGuideMarkdown(const AssemblyGuide& guide, const zome::PriceO
           " struts";
     if (guide.components > 1) md += " in " + std::to_string(guide.components) + " separate parts";
     md += ".\n\n";
-    md +=
-        "Build the frame ball by ball in the order below: breadth-first from the lowest ball, one layer of "
-        "balls at a time, each layer from the bottom up. At each ball, attach the struts listed (the ones "
-        "not "
-        "attached yet); \"new\" means the strut carries a ball that is not in place yet: put a new ball on "
-        "its free end. Positions are in millimetres; directions are as you face the model: x to the right, "
-        "y away from you, z up. Every ball sits the same way round, so a hole that points straight up on one "
-        "ball points straight up on all of them. The number after a hole is zomefab's (blue 0-29, yellow "
-        "30-49, red 50-61).\n\n";
+    md += frameIntroduction() + "\n\n";
     md += "## Parts list\n\n```text\n" + zome::partsTable(guide.parts, prices) + "```\n\n";
     md += "## Frame\n";
     size_t component = size_t(-1), layer = size_t(-1);
@@ -184,14 +215,11 @@ std::string assemblyGuideMarkdown(const AssemblyGuide& guide, const zome::PriceO
             layer = step.layer;
             md += "\n### Layer " + std::to_string(layer) + "\n";
         }
-        md += "\n**" + ballName(step.ball) + "** at " +
-              formatNumbers("(%.1f, %.1f, %.1f) mm", step.positionMm[0], step.positionMm[1],
-                            step.positionMm[2]) +
+        const std::string heading = ballHeading(step);
+        const size_t at = heading.find(" at ");
+        md += "\n**" + heading.substr(0, at) + "**" + heading.substr(at) +
               (step.struts.empty() ? ": nothing new to attach\n" : "\n");
-        for (const StrutStep& s : step.struts)
-            md += "- " + zome::partName(s.color, s.size) + " (" + zome::colorName(s.color) + ") in " +
-                  holeWords(s.hole) + " (" + std::to_string(s.hole) + ") to " + ballName(s.toBall) +
-                  (s.isNewBall ? " (new)" : "") + ", its hole " + std::to_string(s.toHole) + "\n";
+        for (const StrutStep& s : step.struts) md += "- " + strutSentence(s) + "\n";
     }
     if (!guide.mounting.empty()) md += mountingMarkdown(guide.mounting);
     return md;

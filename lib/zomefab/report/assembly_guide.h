@@ -75,6 +75,18 @@ struct AssemblyGuide {
 ///   another direction, into an unknown ball, or into a hole that holds a strut.
 AssemblyGuide assemblyGuide(const zome::Structure& frame, const std::vector<MountingStep>& mounting = {});
 
+/// The guide's sentences, shared by assembly.md and assembly.html (plain text, no markup).
+std::string frameIntroduction();
+std::string mountingIntroduction();
+/// "ball-12 at (-36.7, -53.8, 96.4) mm".
+std::string ballHeading(const BallStep& step);
+/// "B0 (blue) in the blue hole pointing straight up (2) to ball-11 (new), its hole 17".
+std::string strutSentence(const StrutStep& strut);
+/// "piece-05 + piece-08": the pieces of a mounting step.
+std::string mountingTitle(const MountingStep& step);
+/// The glue, approach and pegs sentences of one mounting step.
+std::vector<std::string> mountingSentences(const MountingStep& step);
+
 /// `assembly.md`: the parts list (zome::partsTable, paper Table 2 layout), the layers with each
 /// ball's id, position in mm and the struts to attach (part, the hole by its colour and direction
 /// in words, the ball it leads to), and the mounting steps.

@@ -49,16 +49,8 @@ GlbMaterial material(const std::string& name, double r, double g, double b, doub
     return m;
 }
 
-/// Piece colour @p i: hues spaced by the golden angle, so neighbours in the list differ strongly.
 GlbMaterial pieceMaterial(size_t i, const std::string& name) {
-    const double hue = std::fmod(double(i) * 0.6180339887498949, 1.0) * 6.0;
-    const double s = 0.45, v = 0.95;
-    const int sector = int(hue) % 6;
-    const double f = hue - std::floor(hue);
-    const double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
-    const std::array<std::array<double, 3>, 6> rgb = {
-        {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}}};
-    const auto& c = rgb[size_t(sector)];
+    const std::array<double, 3> c = pieceColorSrgb(i);
     return material(name, c[0], c[1], c[2], 0.7);
 }
 
@@ -166,6 +158,30 @@ GlbMesh prismMesh(const std::string& name, const std::vector<std::array<double, 
 
 }  // namespace
 
+std::array<double, 3> pieceColorSrgb(size_t i) {
+    // Hues spaced by the golden angle, so neighbours in the list differ strongly.
+    const double hue = std::fmod(double(i) * 0.6180339887498949, 1.0) * 6.0;
+    const double s = 0.45, v = 0.95;
+    const int sector = int(hue) % 6;
+    const double f = hue - std::floor(hue);
+    const double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+    const std::array<std::array<double, 3>, 6> rgb = {
+        {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}}};
+    return rgb[size_t(sector)];
+}
+
+std::array<double, 3> strutColorSrgb(zome::Color color) {
+    switch (color) {
+        case zome::Color::Blue:
+            return {0.05, 0.33, 0.75};
+        case zome::Color::Yellow:
+            return {1.0, 0.80, 0.05};
+        case zome::Color::Red:
+            return {0.85, 0.10, 0.10};
+    }
+    return {0.5, 0.5, 0.5};
+}
+
 GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& options) {
     if (!input.pieceNames.empty() && input.pieceNames.size() != input.pieces.size())
         throw Error(ErrorCode::Usage, "preview: " + std::to_string(input.pieceNames.size()) +
@@ -237,8 +253,9 @@ GlbScene buildPreviewScene(const PreviewInput& input, const PreviewOptions& opti
         scene.materials.push_back(material("ball", 0.93, 0.93, 0.90, 0.35));
         const int ballMaterial = int(scene.materials.size() - 1);
         // Zometool's colours, sRGB.
-        const std::array<std::array<double, 3>, 3> strutRgb = {
-            {{0.05, 0.33, 0.75}, {1.0, 0.80, 0.05}, {0.85, 0.10, 0.10}}};
+        const std::array<std::array<double, 3>, 3> strutRgb = {{strutColorSrgb(zome::Color::Blue),
+                                                                strutColorSrgb(zome::Color::Yellow),
+                                                                strutColorSrgb(zome::Color::Red)}};
         std::array<int, zome::kColorCount> strutMaterial{-1, -1, -1};  // created on first use
 
         const std::vector<zome::BallId> balls = frame.ballIds();

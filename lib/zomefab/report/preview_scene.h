@@ -5,6 +5,7 @@
 /// model's millimetres and z-up into glTF's metres and y-up. Layout: docs/preview.md.
 #pragma once
 
+#include <array>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -38,6 +39,12 @@ struct PreviewOptions {
     GlbWriteOptions glb;                 ///< Draco quantisation and speed
     std::string generator;               ///< asset.generator; empty = "zomefab <version>"
 };
+
+/// The colour of piece @p index in the preview (and the guide's pictures), sRGB in [0, 1]: hues
+/// spaced by the golden angle at saturation 0.45, value 0.95.
+std::array<double, 3> pieceColorSrgb(size_t index);
+/// The colour of a strut of @p color, sRGB in [0, 1].
+std::array<double, 3> strutColorSrgb(zome::Color color);
 
 /// Builds the scene. Node names: "piece-NN" (or pieceNames), "ball-<id>", "strut-<id>" with the
 /// frame's ids; group nodes "zomefab" (root), "pieces", "balls", "struts".

@@ -40,11 +40,11 @@ struct RunRecord {
     frame::FrameMetrics frameMetrics;
     TriMesh surfaceFrameMm;  ///< the scaled surface in the frame's coordinates
     partition::PartitionResult partition;
-    pieces::Pieces pieces;             ///< printable pieces, in printer coordinates
-    std::vector<pieces::Plate> plates; ///< the pieces on printer beds, one print job each
-    AssemblyGuide assembly;            ///< build order of the frame and the pieces' tenons
-    CostReport cost;                   ///< Table 1: ZomeFab against the octree baseline
-    std::vector<StageTiming> timings;  ///< in run order
+    pieces::Pieces pieces;              ///< printable pieces, in printer coordinates
+    std::vector<pieces::Plate> plates;  ///< the pieces on printer beds, one print job each
+    AssemblyGuide assembly;             ///< build order of the frame and the pieces' tenons
+    CostReport cost;                    ///< Table 1: ZomeFab against the octree baseline
+    std::vector<StageTiming> timings;   ///< in run order
     double totalSeconds = 0;
 };
 

@@ -8,6 +8,7 @@
 #include "zomefab/core/json_values.h"
 #include "zomefab/core/version.h"
 #include "zomefab/pieces/pieces_io.h"
+#include "zomefab/report/assembly_page.h"
 #include "zomefab/zome/parts.h"
 
 namespace zomefab::report {
@@ -214,6 +215,11 @@ PreviewInput previewInput(const RunRecord& run) {
     PreviewInput input = previewInput(run.pieces, run.frame.structure);
     input.extras = previewExtras(run.sourceName, run.scaled.sizeMm);
     return input;
+}
+
+std::string assemblyPage(const RunRecord& run, const zome::PriceOptions& prices) {
+    return assemblyGuideHtml(run.assembly, previewInput(run),
+                             std::filesystem::path(run.sourceName).filename().string(), prices);
 }
 
 RunSummary runSummaryFromJson(const json& report) {

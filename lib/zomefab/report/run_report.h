@@ -43,6 +43,9 @@ std::string costPage(const RunRecord& run);
 PreviewInput previewInput(const pieces::Pieces& pieces, const zome::Structure& frame);
 /// The same for a run, with its source and size as the scene's extras.
 PreviewInput previewInput(const RunRecord& run);
+/// assembly.html of the run (assembly_page.h): its guide, drawn with the preview's scene, titled
+/// with the input file's name.
+std::string assemblyPage(const RunRecord& run, const zome::PriceOptions& prices);
 /// The preview's scene extras for an object read from @p sourceName at @p sizeMm.
 nlohmann::json previewExtras(const std::string& sourceName, const Vec3d& sizeMm);
 

@@ -5,6 +5,7 @@
 
 #include "zomefab/io/file_io.h"
 #include "zomefab/io/glb_write.h"
+#include "zomefab/report/detail/html.h"
 
 namespace zomefab::report {
 
@@ -16,29 +17,7 @@ extern const char* const kOrbitControlsJs;
 
 namespace {
 
-/// & < > " escaped for HTML text and attributes.
-std::string escapeHtml(const std::string& text) {
-    std::string out;
-    for (const char c : text) {
-        switch (c) {
-            case '&':
-                out += "&amp;";
-                break;
-            case '<':
-                out += "&lt;";
-                break;
-            case '>':
-                out += "&gt;";
-                break;
-            case '"':
-                out += "&quot;";
-                break;
-            default:
-                out += c;
-        }
-    }
-    return out;
-}
+using detail::escapeHtml;
 
 /// The page's own script: decode the inlined GLB, show it, and let the slider play the mounting steps.
 /// It logs "zomefab viewer: ready ..." on the console when the scene is drawn (the tests wait for it).
