@@ -9,6 +9,7 @@
 #include "zomefab/io/file_io.h"
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/pieces/pieces_io.h"
+#include "zomefab/pieces/plates.h"
 #include "zomefab/report/run_report.h"
 
 using namespace zomefab;
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
             mesh::validateClosedMesh(readMesh(meshPath), {}, meshPath, context), scale);
         run.frame.structure = cli::readFrame(framePath);
         run.pieces = pieces::readPieces(piecesPath);
+        run.plates = pieces::packPlates(run.pieces);  // the same plates as zf-pieces wrote
         if (fabricationCli.printer.empty())
             fabrication.printerMm = run.pieces.printerMm;  // the pieces' printer
         report::RunReports reports = report::reportStage(run.frame.structure, run.pieces, run.scaled.mesh,

@@ -11,6 +11,8 @@
 #include "zomefab/core/error.h"
 #include "zomefab/io/file_io.h"
 #include "zomefab/io/mesh_io.h"
+#include "zomefab/pieces/pieces_io.h"
+#include "zomefab/pieces/plates.h"
 #include "zomefab/report/run_report.h"
 #include "zomefab/zome/parts.h"
 #include "zomefab/zome/structure_json.h"
@@ -58,6 +60,13 @@ TEST_CASE("pipeline: the small bunny end to end, outputs consistent with each ot
     CHECK(!fs::exists(out + "/pieces/plates"));  // moved up, next to the preview
     CHECK(fs::exists(out + "/" + pieces::plateFileName(0)));
     CHECK(report["plates"].size() == result.plates.size());
+    // cost.md and report.json list every piece's hours and grams, and every plate's.
+    const std::string costPage = test::readFile(out + "/cost.md");
+    for (size_t i = 0; i < result.pieces.pieces.size(); ++i)
+        CHECK(costPage.find("| " + pieces::pieceName(result.pieces, i) + " | ") != std::string::npos);
+    CHECK(costPage.find("| " + pieces::plateFileName(0) + " | ") != std::string::npos);
+    CHECK(report["cost"]["per_piece"].size() == result.pieces.pieces.size());
+    CHECK(report["cost"]["per_piece"][0]["hollow"]["grams"].get<double>() > 0);
     // The cost report prices exactly the pieces written and the frame's parts.
     CHECK(report["cost"]["pieces"] == result.pieces.pieces.size());
     CHECK(report["cost"]["pieces_volume_mm3"].get<double>() ==

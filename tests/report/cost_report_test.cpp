@@ -72,6 +72,17 @@ TEST_CASE("cost_report: hollow and solid cases against the octree baseline") {
     CHECK(hollow.infillPercent == 20.0);
     CHECK(solid.name == "solid");
     for (const CostCase* c : {&hollow, &solid}) {
+        // One estimate per piece, summing to the case's total; grams from each piece's filament.
+        REQUIRE(c->pieces.size() == sphere.pieces.size());
+        double seconds = 0, mm3 = 0, grams = 0;
+        for (const PieceCost& p : c->pieces) {
+            CHECK(p.print.seconds > 0);
+            CHECK(p.filament.massG > 0);
+            seconds += p.print.seconds, mm3 += p.print.filamentMm3, grams += p.filament.massG;
+        }
+        CHECK(seconds == doctest::Approx(c->zomefab.print.seconds));
+        CHECK(mm3 == doctest::Approx(c->zomefab.print.filamentMm3));
+        CHECK(grams == doctest::Approx(c->zomefab.filament.massG));
         // Savings are 1 − zomefab/baseline, on overall hours and overall USD (paper Table 1).
         CHECK(c->savedTimePercent ==
               doctest::Approx(100 * (1 - c->zomefab.totalHours() / c->baseline.totalHours())));

@@ -86,25 +86,28 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<const TriMesh*>
     std::vector<const TriMesh*> baselinePointers;
     for (const TriMesh& part : baselineParts) baselinePointers.push_back(&part);
     auto printAll = [&](const std::vector<const TriMesh*>& meshes, const PrintSettings& settings,
-                        const std::string& what) {
+                        const std::string& what, std::vector<PieceCost>* each = nullptr) {
         PrintEstimate sum;
         for (size_t i = 0; i < meshes.size(); ++i) {
             context.throwIfCancelled();
             const std::string label =
                 what + " " + std::to_string(i) + " at " + formatNumbers("%.0f", settings.infillPercent) + "%";
+            PrintEstimate part;
             if (options.source == EstimateSource::PrusaSlicer) {
                 try {
-                    sum += sliceWithPrusaSlicer(*meshes[i], settings, label, options.slicer, context);
+                    part = sliceWithPrusaSlicer(*meshes[i], settings, label, options.slicer, context);
                 } catch (const Error& e) {
                     if (e.code() != ErrorCode::ProcessingFailed) throw;
                     // One odd part should not void the whole report: say so and estimate it.
                     context.warn(std::string(e.what()) + "; the estimator's numbers are used for it");
                     report.slicerFallbacks.push_back(label);
-                    sum += estimatePrint(*meshes[i], settings, options.rates);
+                    part = estimatePrint(*meshes[i], settings, options.rates);
                 }
             } else {
-                sum += estimatePrint(*meshes[i], settings, options.rates);
+                part = estimatePrint(*meshes[i], settings, options.rates);
             }
+            sum += part;
+            if (each) each->push_back({part, filamentUse(part.filamentMm3, options.filament)});
             context.progress("report", double(++done) / double(total));
         }
         return sum;
@@ -118,7 +121,7 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<const TriMesh*>
         CostCase c;
         c.name = name;
         c.infillPercent = infill;
-        c.zomefab.print = printAll(piecesMm, settings, std::string(name) + " piece");
+        c.zomefab.print = printAll(piecesMm, settings, std::string(name) + " piece", &c.pieces);
         c.zomefab.filament = filamentUse(c.zomefab.print.filamentMm3, options.filament);
         c.zomefab.assemblyHours = buildHours;
         c.zomefab.zomeUsd = zomeUsd;

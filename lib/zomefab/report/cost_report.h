@@ -56,6 +56,12 @@ struct MakingCost {
     double totalUsd() const { return filament.costUsd + zomeUsd; }
 };
 
+/// One printed piece's print.
+struct PieceCost {
+    PrintEstimate print;
+    FilamentUse filament;  ///< of print.filamentMm3
+};
+
 /// One infill case: ZomeFab against the baseline, and the savings as in Table 1
 /// (saved = 1 − zomefab/baseline, in percent; "material" compares total cost in USD as the paper
 /// does, "filament" compares the plastic alone).
@@ -67,6 +73,9 @@ struct CostCase {
     /// The object printed whole, in one part on a bed large enough for it: what a maker with a
     /// big printer compares against (the honest saving; the octree baseline is the paper's).
     MakingCost whole;
+    /// Each printed piece on its own (in piece order; their sum is zomefab.print): hours and
+    /// filament per piece for the maker's plan.
+    std::vector<PieceCost> pieces;
     double savedTimePercent = 0.0;
     double savedMaterialPercent = 0.0;
     double savedFilamentPercent = 0.0;

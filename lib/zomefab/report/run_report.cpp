@@ -96,6 +96,18 @@ json piecesJson(const RunRecord& run) {
 
 json costJson(const RunRecord& run) {
     json cost = costReportToJson(run.cost);
+    // Per piece, per infill case: what the maker plans prints with.
+    json perPiece = json::array();
+    for (size_t i = 0; i < run.pieces.pieces.size(); ++i) {
+        json row{{"piece", pieces::pieceName(run.pieces, i)}};
+        for (const CostCase& c : run.cost.cases)
+            if (i < c.pieces.size())
+                row[c.name] = {{"hours", c.pieces[i].print.hours()},
+                               {"filament_mm3", c.pieces[i].print.filamentMm3},
+                               {"grams", c.pieces[i].filament.massG}};
+        perPiece.push_back(row);
+    }
+    cost["per_piece"] = perPiece;
     // The headline numbers (paper Table 1's "Efficiency (Saved)" columns), flat for batch summaries.
     for (const CostCase& c : run.cost.cases) {
         cost["time_saved_" + c.name + "_percent"] = c.savedTimePercent;
@@ -173,11 +185,60 @@ json runReportJson(const RunRecord& run, const RunContext& context) {
     return report;
 }
 
+namespace {
+
+/// The plate (1-based) each piece is printed on; 0 when the run has no plates.
+std::vector<size_t> plateOfPiece(const RunRecord& run) {
+    std::vector<size_t> plate(run.pieces.pieces.size(), 0);
+    for (size_t k = 0; k < run.plates.size(); ++k)
+        for (const pieces::PlacedPiece& p : run.plates[k].items) plate[p.piece] = k + 1;
+    return plate;
+}
+
+/// Per piece and per plate: hours and grams in each infill case (the estimator's, or the slicer's).
+std::string perPieceMarkdown(const RunRecord& run) {
+    if (run.cost.cases.empty() || run.cost.cases[0].pieces.size() != run.pieces.pieces.size()) return "";
+    const std::vector<size_t> plate = plateOfPiece(run);
+    std::string head = "| |", rule = "|---|";
+    for (const CostCase& c : run.cost.cases) {
+        head += formatNumbers(" h at %.0f%% | g at %.0f%% |", c.infillPercent, c.infillPercent);
+        rule += "---:|---:|";
+    }
+    std::string md =
+        "\n## Per piece\n\nEach piece's print on its own (no supports counted).\n\n| piece | plate " +
+        head.substr(2) + "\n|---|---:" + rule.substr(4) + "\n";
+    for (size_t i = 0; i < run.pieces.pieces.size(); ++i) {
+        md += "| " + pieces::pieceName(run.pieces, i) + " | " + std::to_string(plate[i]) + " |";
+        for (const CostCase& c : run.cost.cases)
+            md += formatNumbers(" %.1f | %.0f |", c.pieces[i].print.hours(), c.pieces[i].filament.massG);
+        md += "\n";
+    }
+    md += "\n## Per plate (print job)\n\n" + std::to_string(run.plates.size()) +
+          " print jobs, one per file in plates/.\n\n| plate | pieces " + head.substr(2) + "\n|---|---" +
+          rule.substr(4) + "\n";
+    for (size_t k = 0; k < run.plates.size(); ++k) {
+        std::string names;
+        for (const pieces::PlacedPiece& p : run.plates[k].items)
+            names += (names.empty() ? "" : ", ") + pieces::pieceName(run.pieces, p.piece);
+        md += "| " + pieces::plateFileName(k) + " | " + names + " |";
+        for (const CostCase& c : run.cost.cases) {
+            double hours = 0, grams = 0;
+            for (const pieces::PlacedPiece& p : run.plates[k].items)
+                hours += c.pieces[p.piece].print.hours(), grams += c.pieces[p.piece].filament.massG;
+            md += formatNumbers(" %.1f | %.0f |", hours, grams);
+        }
+        md += "\n";
+    }
+    return md;
+}
+
+}  // namespace
+
 std::string costPage(const RunRecord& run) {
     std::string page =
         "# Cost and time: " + std::filesystem::path(run.sourceName).filename().string() + "\n\n";
     for (const std::string& line : runSummaryLines(run)) page += "- " + line + "\n";
-    return page + "\n" + costReportMarkdown(run.cost);
+    return page + "\n" + costReportMarkdown(run.cost) + perPieceMarkdown(run);
 }
 
 json previewExtras(const std::string& sourceName, const Vec3d& sizeMm) {
