@@ -201,3 +201,32 @@ TEST_CASE("level_set: the same input gives the same grid bytes with 1 or 2 threa
     CHECK(one.size() > 1000);
     CHECK(one == two);
 }
+
+TEST_CASE("estimateRunBytes: the object band and interior grid as built, within a factor of two") {
+    // A 100 mm sphere: the estimate comes from its area and volume before any grid exists.
+    const TriMesh sphere = test::makeSphere({0, 0, 0}, 50.0, 48, 96);
+    Fabrication fabrication;
+    ObjectFieldOptions options;
+    options.voxelMm = 1.5;
+    options.fieldVoxelMm = 3.0;
+    const MemoryEstimate e = estimateRunBytes(sphere, fabrication, options);
+    const ObjectField field = makeObjectField(sphere, fabrication, options, RunContext::silent());
+    const double object = double(field.object.activeVoxelCount()),
+                 interior = double(field.interior.activeVoxelCount());
+    CHECK(e.objectVoxels > 0.5 * object);
+    CHECK(e.objectVoxels < 2.0 * object);
+    CHECK(e.interiorVoxels > 0.5 * interior);
+    CHECK(e.interiorVoxels < 2.0 * interior);
+    CHECK(e.bytes == doctest::Approx(40.0 * (e.objectVoxels + e.interiorVoxels)));
+    // Over the budget: refused before anything is built, naming the options that lower it.
+    options.maxMemoryGb = e.bytes / 2e9;
+    try {
+        makeObjectField(sphere, fabrication, options, RunContext::silent());
+        FAIL("no error");
+    } catch (const Error& err) {
+        CHECK(err.code() == ErrorCode::ProcessingFailed);
+        CHECK(std::string(err.what()).find("--voxel-mm") != std::string::npos);
+    }
+    CHECK(memoryBudgetBytes(2.5) == doctest::Approx(2.5e9));
+    CHECK(memoryBudgetBytes(0) > 1e8);  // a share of this machine's memory
+}

@@ -129,6 +129,10 @@ void FieldCli::addTo(CLI::App& app) {
     app.add_option("--field-voxel-mm", options.fieldVoxelMm,
                    "Voxel size of the interior grid (frame optimisation)")
         ->capture_default_str();
+    app.add_option(
+           "--max-memory-gb", options.maxMemoryGb,
+           "Refuse a size whose grids would need more memory than this, GB (0 = 75 % of this machine's)")
+        ->capture_default_str();
 }
 
 // --- frame (paper §4) -----------------------------------------------------------------------------

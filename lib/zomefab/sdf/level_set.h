@@ -98,7 +98,25 @@ struct ObjectFieldOptions {
     double fieldVoxelMm = 2.0;
     /// The "interior" grid is exact this far outside too (frame nodes that stray outside).
     double fieldExteriorMm = 10.0;
+    /// Memory budget of the run, GB: makeObjectField refuses, before it allocates anything, a size
+    /// whose grids would need more (estimateRunBytes). 0 = 75 % of the machine's physical memory.
+    double maxMemoryGb = 0.0;
 };
+
+/// What a run at this size will need at its peak, estimated from the mesh before any grid exists:
+/// the "object" band (surface area × (wall + 3 voxels) / voxel³), the "interior" grid (volume and
+/// its exterior band at fieldVoxelMm), 40 bytes per voxel for the grids and what the later stages
+/// build from them (calibrated on the bunny at 400 and 800 mm: 452 MB / 2.36 GB estimated, 479 MB /
+/// 1.89 GB measured; docs/sdf.md, "Memory guard").
+struct MemoryEstimate {
+    double objectVoxels = 0, interiorVoxels = 0;
+    double bytes = 0;
+};
+MemoryEstimate estimateRunBytes(const TriMesh& meshMm, const Fabrication& fabrication,
+                                const ObjectFieldOptions& options);
+
+/// The budget in bytes: @p maxMemoryGb, or 75 % of the physical memory when it is 0.
+double memoryBudgetBytes(double maxMemoryGb);
 
 /// The object's distance fields: "object" (fine, exact as deep as the wall is thick) and
 /// "interior" (coarse, whole inside), both in the mesh's millimetres.

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Mesh -> narrow-band level set with openvdb::tools::meshToVolume, reading the TriMesh in place.
 #include <openvdb/tools/MeshToVolume.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <cmath>
@@ -9,6 +10,7 @@
 
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
+#include "zomefab/core/vec.h"
 #include "zomefab/sdf/level_set_grid.h"
 
 namespace zomefab::sdf {
@@ -177,12 +179,67 @@ void checkObjectFieldOptions(const ObjectFieldOptions& options) {
     requirePositive(options.fieldVoxelMm, "the interior field's voxel size");
     if (!(options.fieldExteriorMm >= 0) || !std::isfinite(options.fieldExteriorMm))
         throw Error(ErrorCode::Usage, "the interior field's exterior band must be ≥ 0 mm");
+    if (!(options.maxMemoryGb >= 0) || !std::isfinite(options.maxMemoryGb) || options.maxMemoryGb > 1e6)
+        throw Error(ErrorCode::Usage,
+                    "--max-memory-gb must be in [0, 1e6] (0 = 75 % of this machine's memory)");
 }
+
+MemoryEstimate estimateRunBytes(const TriMesh& meshMm, const Fabrication& fabrication,
+                                const ObjectFieldOptions& options) {
+    double areaMm2 = 0;
+    for (const Triangle& t : meshMm.triangles) {
+        const auto& a = meshMm.positions[t[0]];
+        const auto& b = meshMm.positions[t[1]];
+        const auto& c = meshMm.positions[t[2]];
+        const Vec3d u{double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
+        const Vec3d v{double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
+        areaMm2 += 0.5 * norm(cross(u, v));
+    }
+    const double volumeMm3 = std::fabs(signedVolume(meshMm));
+    MemoryEstimate e;
+    const double v = options.voxelMm, f = options.fieldVoxelMm;
+    e.objectVoxels = areaMm2 * (fabrication.wallMm + 3.0 * v) / (v * v * v);
+    e.interiorVoxels = (volumeMm3 + areaMm2 * options.fieldExteriorMm) / (f * f * f);
+    constexpr double kBytesPerVoxel = 40.0;
+    e.bytes = kBytesPerVoxel * (e.objectVoxels + e.interiorVoxels);
+    return e;
+}
+
+double memoryBudgetBytes(double maxMemoryGb) {
+    if (maxMemoryGb > 0) return maxMemoryGb * 1e9;
+    const double pages = double(::sysconf(_SC_PHYS_PAGES)), pageBytes = double(::sysconf(_SC_PAGESIZE));
+    return pages > 0 && pageBytes > 0 ? 0.75 * pages * pageBytes : 8e9;
+}
+
+namespace {
+
+/// Refuses (exit 3) a size whose grids would not fit the budget, with the estimate and what lowers it.
+void requireMemory(const TriMesh& meshMm, const Fabrication& fabrication, const ObjectFieldOptions& options) {
+    const MemoryEstimate e = estimateRunBytes(meshMm, fabrication, options);
+    const double budget = memoryBudgetBytes(options.maxMemoryGb);
+    if (e.bytes <= budget) return;
+    // The object band shrinks with the voxel squared, the interior grid with its cube: growing both
+    // voxels by the cube root of the excess is enough.
+    const double grow = std::cbrt(e.bytes / budget) * 1.05;
+    throw Error(
+        ErrorCode::ProcessingFailed,
+        formatNumbers("this size needs about %.1f GB (%.0f M voxels in the object band at --voxel-mm %g, "
+                      "%.0f M in the interior grid at --field-voxel-mm %g), more than the %.1f GB budget",
+                      e.bytes / 1e9, e.objectVoxels / 1e6, options.voxelMm, e.interiorVoxels / 1e6,
+                      options.fieldVoxelMm, budget / 1e9) +
+            formatNumbers(": use --voxel-mm %.2g --field-voxel-mm %.2g, a smaller --height-mm, or a larger "
+                          "--max-memory-gb",
+                          std::ceil(options.voxelMm * grow * 100) / 100,
+                          std::ceil(options.fieldVoxelMm * grow * 100) / 100));
+}
+
+}  // namespace
 
 ObjectField makeObjectField(const TriMesh& meshMm, const Fabrication& fabrication,
                             const ObjectFieldOptions& options, RunContext& context) {
     checkFabrication(fabrication);
     checkObjectFieldOptions(options);
+    requireMemory(meshMm, fabrication, options);  // before any grid is allocated
     ObjectField field;
     MeshToLevelSetOptions object;
     object.voxelMm = options.voxelMm;
