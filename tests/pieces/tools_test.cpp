@@ -56,7 +56,7 @@ std::string admeshField(const std::string& report, const std::string& label) {
 
 }  // namespace
 
-TEST_CASE("zf-pieces: one closed STL per piece, pieces.3mf and pieces.json") {
+TEST_CASE("zf-pieces: one closed STL per piece, a 3MF per plate and pieces.json") {
     const Run& r = shared();
     REQUIRE(r.exitCode == 0);
     const nlohmann::json j = nlohmann::json::parse(test::readFile(r.out("pieces.json")));
