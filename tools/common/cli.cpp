@@ -130,6 +130,8 @@ int Tool::run(int argc, char** argv, const std::function<int(nlohmann::json&)>& 
                                                             size_t(mCommon.threads));
 
     try {
+        // A --report that cannot be written fails now, before any other output exists.
+        if (!mCommon.reportPath.empty()) checkOutputPath(mCommon.reportPath);
         nlohmann::json report;
         const int code = body(report);
         if (!mCommon.reportPath.empty()) {

@@ -37,6 +37,23 @@ std::string readInputBytes(const std::string& path) {
     return bytes;
 }
 
+void checkOutputPath(const std::string& path) {
+    if (path == "-") return;
+    const fs::path target(path);
+    std::error_code ec;
+    if (fs::is_directory(target, ec)) throw Error(ErrorCode::WriteFailed, "is a directory, not a file", path);
+    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    if (!fs::is_directory(dir, ec))
+        throw Error(ErrorCode::WriteFailed, "directory does not exist: " + dir.string(), path);
+    const fs::file_status status = fs::symlink_status(target, ec);
+    if (fs::exists(status) && !fs::is_regular_file(status))
+        throw Error(ErrorCode::WriteFailed,
+                    "exists and is not a regular file (a device, FIFO, socket or link): it is not replaced",
+                    path);
+    if (::access(dir.c_str(), W_OK) != 0)
+        throw Error(ErrorCode::WriteFailed, "directory is not writable: " + dir.string(), path);
+}
+
 void writeOutputAtomic(const std::string& path, const std::function<void(std::ostream&)>& write) {
     if (path == "-") {
         write(std::cout);
@@ -44,12 +61,10 @@ void writeOutputAtomic(const std::string& path, const std::function<void(std::os
         if (!std::cout) throw Error(ErrorCode::WriteFailed, "cannot write to stdout", "-");
         return;
     }
+    checkOutputPath(path);
     const fs::path target(path);
     std::error_code ec;
-    if (fs::is_directory(target, ec)) throw Error(ErrorCode::WriteFailed, "is a directory, not a file", path);
     const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    if (!fs::is_directory(dir, ec))
-        throw Error(ErrorCode::WriteFailed, "directory does not exist: " + dir.string(), path);
     const fs::path temp = dir / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()));
     try {
         {

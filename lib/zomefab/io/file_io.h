@@ -17,6 +17,11 @@ std::string readInputBytes(const std::string& path);
 /// @throw Error(WriteFailed) naming the file; whatever @p write throws is rethrown after cleanup.
 void writeOutputAtomic(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+/// What writeOutputAtomic would refuse, checked before any work: @p path is a directory, its
+/// directory does not exist or is not writable, or it exists and is not a regular file (a device,
+/// FIFO, socket or symbolic link is never replaced). "-" passes. @throw Error(WriteFailed) naming it.
+void checkOutputPath(const std::string& path);
+
 /// The file every output directory zomefab writes carries: one name per line of what it wrote.
 inline constexpr const char* kOutputManifestFile = ".zomefab-output";
 
