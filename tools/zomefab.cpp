@@ -9,6 +9,7 @@
 #include "common/cli.h"
 #include "common/run_options.h"
 #include "zomefab/core/error.h"
+#include "zomefab/io/file_io.h"
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/report/run_report.h"
 #include "zomefab/verify/verify.h"
@@ -20,6 +21,7 @@ namespace {
 
 int runCommand(cli::Tool& tool, const cli::RunCli& cli, json& report) {
     pipeline::RunOptions options = cli.resolve(tool.common().seed);
+    checkOutputDirectory(cli.outDir);  // a mistyped -o fails now, not after the whole run
     MeshReadOptions readOptions;
     if (!cli.inFormat.empty()) readOptions.format = meshFormatFromName(cli.inFormat);
     const TriMesh mesh = readMesh(cli.input, readOptions);

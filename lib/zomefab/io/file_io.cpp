@@ -123,17 +123,25 @@ std::string replaceRefusal(const fs::path& target) {
 
 }  // namespace
 
-StagedDirectory::StagedDirectory(const std::string& target) : mTarget(target) {
+std::string checkOutputDirectory(const std::string& target) {
     fs::path t(target);
     while (!t.empty() && t.filename().empty()) t = t.parent_path();  // "out/" -> "out"
     if (t.empty()) throw Error(ErrorCode::WriteFailed, "empty output directory name", target);
-    mTarget = t.string();
     const fs::path parent = t.has_parent_path() ? t.parent_path() : fs::path(".");
     std::error_code ec;
     if (!fs::is_directory(parent, ec))
         throw Error(ErrorCode::WriteFailed, "parent directory does not exist: " + parent.string(), target);
     if (fs::exists(t, ec) && !fs::is_directory(t, ec))
         throw Error(ErrorCode::WriteFailed, "exists and is not a directory", target);
+    if (::access(parent.c_str(), W_OK) != 0)
+        throw Error(ErrorCode::WriteFailed, "parent directory is not writable: " + parent.string(), target);
+    return t.string();
+}
+
+StagedDirectory::StagedDirectory(const std::string& target) : mTarget(checkOutputDirectory(target)) {
+    const fs::path t(mTarget);
+    const fs::path parent = t.has_parent_path() ? t.parent_path() : fs::path(".");
+    std::error_code ec;
     removeStaleStaging(parent, t.filename().string());
     mStaging = (parent / ("." + t.filename().string() + ".tmp" + std::to_string(::getpid()))).string();
     fs::remove_all(mStaging, ec);

@@ -22,6 +22,11 @@ void writeOutputAtomic(const std::string& path, const std::function<void(std::os
 /// FIFO, socket or symbolic link is never replaced). "-" passes. @throw Error(WriteFailed) naming it.
 void checkOutputPath(const std::string& path);
 
+/// What StagedDirectory would refuse, checked before any work: an empty name, a parent directory
+/// that does not exist or is not writable, a target that exists and is not a directory. Returns the
+/// target without trailing slashes. @throw Error(WriteFailed) naming it.
+std::string checkOutputDirectory(const std::string& target);
+
 /// The file every output directory zomefab writes carries: one name per line of what it wrote.
 inline constexpr const char* kOutputManifestFile = ".zomefab-output";
 
