@@ -15,7 +15,7 @@
 
 namespace zomefab::test {
 
-bool hasChromium() { return std::system("command -v chromium > /dev/null 2>&1") == 0; }
+bool hasChromium() { return hasCommand("chromium"); }
 
 namespace {
 

@@ -58,10 +58,6 @@ inline std::string viewBytes(const Glb& g, int view) {
     return g.bin.substr(v["byteOffset"].get<size_t>(), v["byteLength"].get<size_t>());
 }
 
-inline bool hasCommand(const std::string& name) {
-    return std::system(("command -v " + name + " > /dev/null 2>&1").c_str()) == 0;
-}
-
 #if defined(ZOMEFAB_NODE_DIR) && defined(ZOMEFAB_VALIDATOR_SCRIPT)
 /// The npm prefix holding gltf-validator (`make test-deps`); ZOMEFAB_NODE_DIR in the environment wins.
 inline std::string nodePrefix() {
@@ -73,7 +69,8 @@ inline std::string nodePrefix() {
 inline nlohmann::json khronosValidate(const std::string& path) {
     std::string out;
     const int code = runCapture(
-        "node '" + std::string(ZOMEFAB_VALIDATOR_SCRIPT) + "' '" + nodePrefix() + "' '" + path + "' 2>&1", &out);
+        "node '" + std::string(ZOMEFAB_VALIDATOR_SCRIPT) + "' '" + nodePrefix() + "' '" + path + "' 2>&1",
+        &out);
     INFO("validator output: " << out);
     REQUIRE(code >= 0);
     REQUIRE(code != 2);  // 2 = validator missing: run `make test-deps`

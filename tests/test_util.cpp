@@ -50,6 +50,10 @@ int runCapture(const std::string& command, std::string* out) {
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+bool hasCommand(const std::string& name) {
+    return std::system(("command -v " + name + " > /dev/null 2>&1").c_str()) == 0;
+}
+
 std::string readFile(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -64,9 +68,11 @@ void writeBytes(const std::string& path, const std::string& bytes) {
 TriMesh makeBox(const Vec3d& a, const Vec3d& b) {
     TriMesh m;
     for (int i = 0; i < 8; ++i)
-        m.positions.push_back({float(i & 1 ? b[0] : a[0]), float(i & 2 ? b[1] : a[1]), float(i & 4 ? b[2] : a[2])});
+        m.positions.push_back(
+            {float(i & 1 ? b[0] : a[0]), float(i & 2 ? b[1] : a[1]), float(i & 4 ? b[2] : a[2])});
     // Each face as two counter-clockwise triangles seen from outside.
-    const uint32_t faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    const uint32_t faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                  {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
     for (const auto& f : faces) {
         m.triangles.push_back({f[0], f[1], f[2]});
         m.triangles.push_back({f[0], f[2], f[3]});
@@ -96,7 +102,8 @@ TriMesh makeSphere(const Vec3d& c, double r, int rings, int segments) {
             m.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
             m.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
         }
-    for (int j = 0; j < segments; ++j) m.triangles.push_back({south, ring(rings - 1, j + 1), ring(rings - 1, j)});
+    for (int j = 0; j < segments; ++j)
+        m.triangles.push_back({south, ring(rings - 1, j + 1), ring(rings - 1, j)});
     return m;
 }
 

@@ -40,6 +40,9 @@ int runShell(const std::string& command);
 /// with its stdout in @p out when given (add `2>&1` to the command for stderr too).
 int runCapture(const std::string& command, std::string* out = nullptr);
 
+/// @p name is a command on PATH.
+bool hasCommand(const std::string& name);
+
 /// The whole file @p path as bytes (empty when it cannot be read).
 std::string readFile(const std::string& path);
 

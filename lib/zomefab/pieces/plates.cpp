@@ -37,15 +37,19 @@ bool fits(double widthMm, double depthMm, double bedX, double bedY) {
     return widthMm <= bedX + kFitToleranceMm && depthMm <= bedY + kFitToleranceMm;
 }
 
-/// Long side along the bed's longer side when that fits in the margined area, else whichever fits.
+/// The first of (long side along the bed's longer side, turned the other way) that fits the margined
+/// area, else the first that fits the whole bed, else the first (packPlates then refuses it).
 Footprint footprintOf(const Pieces& all, size_t index, double usableX, double usableY) {
     Footprint f{index, boundingBox(all.pieces[index].mesh), false};
     const Vec3d size = f.box.size();
-    const bool isLandscape = (size[0] >= size[1]) == (usableX >= usableY);
-    f.isTurned = !isLandscape;
-    if (!fits(f.widthMm(), f.depthMm(), usableX, usableY)) f.isTurned = !f.isTurned;
-    if (!fits(f.widthMm(), f.depthMm(), usableX, usableY)) f.isTurned = !isLandscape;
-    if (!fits(f.widthMm(), f.depthMm(), all.printerMm[0], all.printerMm[1])) f.isTurned = !f.isTurned;
+    const bool isAligned = (size[0] >= size[1]) == (usableX >= usableY);
+    const bool choices[2] = {!isAligned, isAligned};  // isTurned, preferred first
+    for (const auto& [x, y] : {std::pair{usableX, usableY}, std::pair{all.printerMm[0], all.printerMm[1]}})
+        for (const bool isTurned : choices) {
+            f.isTurned = isTurned;
+            if (fits(f.widthMm(), f.depthMm(), x, y)) return f;
+        }
+    f.isTurned = choices[0];
     return f;
 }
 

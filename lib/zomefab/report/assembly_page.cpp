@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <map>
-#include <set>
 
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
@@ -75,8 +74,6 @@ struct Scene {
     }
 };
 
-Rgb strutColor(zome::Color c) { return strutColorSrgb(c); }
-
 /// The frame from the front, a little from the right and above: x to the right, y away, z up.
 Picture framePicture(const Scene& scene) {
     return Picture(kPictureWidthPx, kPictureHeightPx, scene.framePoints, scene.ballRadiusMm,
@@ -87,22 +84,20 @@ Picture framePicture(const Scene& scene) {
 /// the balls they bring in colour (balls white), nothing of later layers.
 std::string layerFigure(const Scene& scene, const AssemblyGuide& guide, size_t component, size_t layer) {
     Picture picture = framePicture(scene);
-    std::set<zome::BallId> placed;
+    // Every ball in place once: white where the layer works (its balls, the new ones it brings), grey before.
+    std::map<zome::BallId, bool> isWhite;
     for (const BallStep& step : guide.steps) {
         const bool before = step.component < component || (step.component == component && step.layer < layer);
         const bool now = step.component == component && step.layer == layer;
         if (!before && !now) continue;
-        placed.insert(step.ball);
+        isWhite[step.ball] |= now;
         for (const StrutStep& s : step.struts) {
-            scene.strut(picture, s.strut, now ? strutColor(s.color) : kGreyPart);
-            placed.insert(s.toBall);
-            if (now && s.isNewBall)
-                picture.sphere(scene.frame.ball(s.toBall).positionMm, scene.ballRadiusMm, kBall);
+            scene.strut(picture, s.strut, now ? strutColorSrgb(s.color) : kGreyPart);
+            isWhite[s.toBall] |= now && s.isNewBall;
         }
-        picture.sphere(step.positionMm, scene.ballRadiusMm, now ? kBall : kGreyPart);
     }
-    for (const zome::BallId b : placed)
-        picture.sphere(scene.frame.ball(b).positionMm, scene.ballRadiusMm, kGreyPart);
+    for (const auto& [ball, white] : isWhite)
+        picture.sphere(scene.frame.ball(ball).positionMm, scene.ballRadiusMm, white ? kBall : kGreyPart);
     const std::string name = "Layer " + std::to_string(layer);
     return figure(picture, name,
                   name + ": the struts to attach in colour (new balls white), the frame built so far grey.");
@@ -134,7 +129,7 @@ std::string stepFigure(const Scene& scene, const AssemblyGuide& guide, size_t st
                 tail = add(centre, scale(approach, 1.05 * size));
     Picture picture = stepPicture(scene, approach, tail);
     for (const zome::StrutId id : scene.frame.strutIds())
-        scene.strut(picture, id, strutColor(scene.frame.strut(id).color));
+        scene.strut(picture, id, strutColorSrgb(scene.frame.strut(id).color));
     for (const zome::BallId id : scene.frame.ballIds())
         picture.sphere(scene.frame.ball(id).positionMm, scene.ballRadiusMm, kBall);
     for (size_t s = 0; s < stepIndex; ++s)

@@ -199,14 +199,14 @@ std::vector<size_t> plateOfPiece(const RunRecord& run) {
 std::string perPieceMarkdown(const RunRecord& run) {
     if (run.cost.cases.empty() || run.cost.cases[0].pieces.size() != run.pieces.pieces.size()) return "";
     const std::vector<size_t> plate = plateOfPiece(run);
-    std::string head = "| |", rule = "|---|";
+    std::string columns, rule;  // hours and grams per infill case
     for (const CostCase& c : run.cost.cases) {
-        head += formatNumbers(" h at %.0f%% | g at %.0f%% |", c.infillPercent, c.infillPercent);
+        columns += formatNumbers(" h at %.0f%% | g at %.0f%% |", c.infillPercent, c.infillPercent);
         rule += "---:|---:|";
     }
     std::string md =
-        "\n## Per piece\n\nEach piece's print on its own (no supports counted).\n\n| piece | plate " +
-        head.substr(2) + "\n|---|---:" + rule.substr(4) + "\n";
+        "\n## Per piece\n\nEach piece's print on its own (no supports counted).\n\n| piece | plate |" +
+        columns + "\n|---|---:|" + rule + "\n";
     for (size_t i = 0; i < run.pieces.pieces.size(); ++i) {
         md += "| " + pieces::pieceName(run.pieces, i) + " | " + std::to_string(plate[i]) + " |";
         for (const CostCase& c : run.cost.cases)
@@ -214,8 +214,8 @@ std::string perPieceMarkdown(const RunRecord& run) {
         md += "\n";
     }
     md += "\n## Per plate (print job)\n\n" + std::to_string(run.plates.size()) +
-          " print jobs, one per file in plates/.\n\n| plate | pieces " + head.substr(2) + "\n|---|---" +
-          rule.substr(4) + "\n";
+          " print jobs, one per file in plates/.\n\n| plate | pieces |" + columns + "\n|---|---|" + rule +
+          "\n";
     for (size_t k = 0; k < run.plates.size(); ++k) {
         std::string names;
         for (const pieces::PlacedPiece& p : run.plates[k].items)
