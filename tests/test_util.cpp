@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "test_util.h"
 
+#include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -48,6 +50,35 @@ int runCapture(const std::string& command, std::string* out) {
     const int status = ::pclose(pipe);
     if (out) *out = std::move(text);
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+MeasuredRun runMeasured(const std::vector<std::string>& argv) {
+    MeasuredRun run;
+    char errPath[] = "/tmp/zomefab-test-stderr-XXXXXX";
+    const int errFd = ::mkstemp(errPath);
+    if (errFd < 0 || argv.empty()) return run;
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        const int devNull = ::open("/dev/null", O_WRONLY);
+        ::dup2(devNull, 1);
+        ::dup2(errFd, 2);
+        std::vector<char*> args;
+        for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+        args.push_back(nullptr);
+        ::execv(args[0], args.data());
+        ::_exit(127);
+    }
+    int status = 0;
+    struct rusage usage {};
+    if (pid > 0 && ::wait4(pid, &status, 0, &usage) == pid) {
+        run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        run.signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+        run.peakRssKb = usage.ru_maxrss;
+    }
+    ::close(errFd);
+    run.stderrText = readFile(errPath);
+    ::unlink(errPath);
+    return run;
 }
 
 bool hasCommand(const std::string& name) {

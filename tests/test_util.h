@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "zomefab/core/error.h"
 #include "zomefab/core/tri_mesh.h"
@@ -39,6 +40,18 @@ int runShell(const std::string& command);
 /// Runs @p command through the shell (popen); its exit code (−1 when it did not exit normally),
 /// with its stdout in @p out when given (add `2>&1` to the command for stderr too).
 int runCapture(const std::string& command, std::string* out = nullptr);
+
+/// What runMeasured saw of one process.
+struct MeasuredRun {
+    int exitCode = -1;       ///< -1 when it did not exit normally (a signal)
+    int signal = 0;          ///< the signal that ended it, 0 when it exited
+    long peakRssKb = 0;      ///< its maximum resident set (wait4's ru_maxrss)
+    std::string stderrText;  ///< what it wrote to stderr
+};
+
+/// Runs @p argv (argv[0] a path, no shell) with stdout discarded, and reports its exit, its peak
+/// memory and its stderr.
+MeasuredRun runMeasured(const std::vector<std::string>& argv);
 
 /// @p name is a command on PATH.
 bool hasCommand(const std::string& name);

@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
         const Transform4d transformMm =
             frame::frameTransformMm(levelSet.info().transformMm, result.rotationDeg);
         const nlohmann::json frameJson = zome::structureToJson(result.structure, transformMm);
-        writeOutputAtomic(output, [&](std::ostream& out) { out << frameJson.dump(1) << '\n'; });
+        tool.writeOutput(output, [&](std::ostream& out) { out << frameJson.dump(1) << '\n'; });
 
         const zome::PartsList parts = zome::partsList(result.structure);
         cli::printInfo(tool, std::to_string(parts.balls) + " balls, " + std::to_string(parts.strutTotal()) +

@@ -67,7 +67,8 @@ int main(int argc, char** argv) {
                  "Report meshes that fail validation (\"valid\": false and the error) instead of failing");
 
     return tool.run(argc, argv, [&](json& report) {
-        const mesh::ScaleOptions scaleOptions = scaleCli.resolve();  // bad options fail before any input is read
+        const mesh::ScaleOptions scaleOptions =
+            scaleCli.resolve();  // bad options fail before any input is read
         MeshReadOptions readOptions;
         if (!inFormat.empty()) readOptions.format = meshFormatFromName(inFormat);
         report = {{"format", "zomefab.info"},

@@ -46,7 +46,8 @@ int main(int argc, char** argv) {
     return tool.run(argc, argv, [&](json& report) {
         const Fabrication fabrication = fabricationCli.resolve(tool.common().seed);
         partition::PartitionOptions opt = partitionCli.resolve();
-        partition::checkPartitionOptions(opt, fabrication);  // bad options fail before any input is read
+        partition::checkPartitionOptions(opt, fabrication);    // bad options fail before any input is read
+        if (!coloredPly.empty()) checkOutputPath(coloredPly);  // and an unwritable --colored-ply
         MeshReadOptions readOptions;
         if (!inFormat.empty()) readOptions.format = meshFormatFromName(inFormat);
         TriMesh mesh = readMesh(meshPath, readOptions);
@@ -70,10 +71,10 @@ int main(int argc, char** argv) {
                                                 std::filesystem::path(framePath).filename().string(),
                                                 transformMm, mesh.positions.size()};
         const std::string text = partition::partitionToJson(r, opt, info).dump(1) + "\n";
-        writeOutputAtomic(output, [&](std::ostream& out) { out << text; });
+        tool.writeOutput(output, [&](std::ostream& out) { out << text; });
         if (!coloredPly.empty()) {
             const std::string bytes = partition::coloredPlyBytes(mesh, partition::faceGroups(r, colorBy));
-            writeOutputAtomic(coloredPly, [&](std::ostream& out) {
+            tool.writeOutput(coloredPly, [&](std::ostream& out) {
                 out.write(bytes.data(), std::streamsize(bytes.size()));
             });
         }

@@ -85,8 +85,8 @@ int main(int argc, char** argv) {
                     .sizeMm);
         const std::string glb = serializeGlb(report::buildPreviewScene(input, options), options.glb);
         if (!viewer.empty()) report::writeViewer(input, options, viewer);  // first: a failure leaves no GLB
-        writeOutputAtomic(output,
-                          [&](std::ostream& out) { out.write(glb.data(), std::streamsize(glb.size())); });
+        tool.writeOutput(output,
+                         [&](std::ostream& out) { out.write(glb.data(), std::streamsize(glb.size())); });
 
         report = {{"frame", framePath},         {"pieces", input.pieces.size()},
                   {"balls", frame.ballCount()}, {"struts", frame.strutCount()},

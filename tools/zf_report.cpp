@@ -51,12 +51,12 @@ int main(int argc, char** argv) {
                                                          fabrication, costOptions, context);
         run.assembly = std::move(reports.assembly);
         run.cost = std::move(reports.cost);
-        writeOutputAtomic(outDir + "/assembly.md", [&](std::ostream& out) {
+        tool.writeOutput(outDir + "/assembly.md", [&](std::ostream& out) {
             out << report::assemblyGuideMarkdown(run.assembly, costOptions.prices);
         });
-        writeOutputAtomic(outDir + "/assembly.html",
-                          [&](std::ostream& out) { out << report::assemblyPage(run, costOptions.prices); });
-        writeOutputAtomic(outDir + "/cost.md", [&](std::ostream& out) { out << report::costPage(run); });
+        tool.writeOutput(outDir + "/assembly.html",
+                         [&](std::ostream& out) { out << report::assemblyPage(run, costOptions.prices); });
+        tool.writeOutput(outDir + "/cost.md", [&](std::ostream& out) { out << report::costPage(run); });
         report = report::costReportToJson(run.cost);
         for (const std::string& line : report::runSummaryLines(run)) cli::printInfo(tool, line);
         return 0;

@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
             levelSet->info().generator = generatorString();
             levelSet->info().transformMm = scaled.transformMm;
         }
-        writeOutputAtomic(output, [&](std::ostream& out) {
+        tool.writeOutput(output, [&](std::ostream& out) {
             sdf::writeVdb({field.object, field.interior}, out);
         });
         const double totalSeconds = clock.seconds();

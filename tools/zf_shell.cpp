@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
         sdf::LevelSet shell = sdf::makeShell(object, fabrication, context);
         shell.info().generator = generatorString();
         const double shellSeconds = clock.seconds() - readSeconds;
-        writeOutputAtomic(output, [&](std::ostream& out) { sdf::writeVdb({shell}, out); });
+        tool.writeOutput(output, [&](std::ostream& out) { sdf::writeVdb({shell}, out); });
 
         report["input"] = input;
         report["output"] = output;

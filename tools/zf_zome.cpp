@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
             const std::vector<zome::Collision> collisions = zome::findCollisions(frame);
             const zome::PartsList list = zome::partsList(frame);
             const nlohmann::json out = zome::checkReportJson(frame, input, collisions, prices);
-            cli::writeJsonFile(out, output);
+            tool.writeOutput(output, [&](std::ostream& o) { o << out.dump(2) << '\n'; });
             report["collisions"] = collisions.size();
             report["seconds"] = clock.seconds();
             if (!collisions.empty()) {
@@ -84,11 +84,11 @@ int main(int argc, char** argv) {
             cli::printInfo(tool, summary + ", 0 collisions, parts cost " + cost);
         } else if (vef->parsed()) {
             const std::string text = zome::structureToVef(frame);
-            writeOutputAtomic(output, [&](std::ostream& out) { out << text; });
+            tool.writeOutput(output, [&](std::ostream& out) { out << text; });
             cli::printInfo(tool, summary + " -> " + output);
         } else {
             const std::string table = zome::partsTable(zome::partsList(frame), prices);
-            writeOutputAtomic(output, [&](std::ostream& out) { out << table; });
+            tool.writeOutput(output, [&](std::ostream& out) { out << table; });
             cli::printInfo(tool, summary);
         }
         report["seconds"] = clock.seconds();

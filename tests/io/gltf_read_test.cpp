@@ -257,3 +257,37 @@ TEST_CASE("gltf: with libdraco linked too, the reader works or refuses clearly, 
 #endif
 }
 #endif
+
+#if !defined(ZOMEFAB_TEST_WITH_DRACO) || ZOMEFAB_TEST_WITH_DRACO == 1
+TEST_CASE("gltf: node instancing may not expand a small file without bound") {
+    // One mesh of 4095 unindexed vertices (1365 triangles), used by 300 nodes: 1.2 M vertices, more
+    // than 16 times what the file stores and more than the 1 M floor.
+    std::string bin;
+    for (int v = 0; v < 4095; ++v)
+        for (float x : {float(v % 7), float(v % 11), float(v % 13)}) put<float>(bin, x);
+    auto scene = [&](int instances) {
+        std::string nodes = "[", sceneNodes = "[";
+        for (int i = 0; i < instances; ++i) {
+            nodes += std::string(i ? "," : "") + R"({"mesh":0,"translation":[)" + std::to_string(20 * i) +
+                     ",0,0]}";
+            sceneNodes += (i ? "," : "") + std::to_string(i);
+        }
+        return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":)" + sceneNodes +
+               R"(]}],"nodes":)" + nodes +
+               R"(],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"buffers":[{"byteLength":)" +
+               std::to_string(bin.size()) + R"(,"uri":"data:application/octet-stream;base64,)" + base64(bin) +
+               R"("}],"bufferViews":[{"buffer":0,"byteLength":)" + std::to_string(bin.size()) +
+               R"(}],"accessors":[{"bufferView":0,"componentType":5126,"count":4095,"type":"VEC3"}]})";
+    };
+    MeshReadOptions noWeld;
+    noWeld.weldVertices = false;
+    CHECK(parseMesh(scene(16), MeshFormat::Gltf, "few.gltf", noWeld).vertexCount() == 16 * 4095);
+    try {
+        parseMesh(scene(300), MeshFormat::Gltf, "many.gltf", noWeld);
+        FAIL("no error");
+    } catch (const Error& e) {
+        CHECK(e.code() == ErrorCode::InvalidInput);
+        CHECK(std::string(e.what()).find("many.gltf: glTF nodes use its meshes so often") == 0);
+    }
+}
+#endif

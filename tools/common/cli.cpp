@@ -138,8 +138,9 @@ int Tool::run(int argc, char** argv, const std::function<int(nlohmann::json&)>& 
             report["tool"] = mName;
             report["generator"] = generatorString();
             report["warnings"] = mContext->warnings();
-            writeJsonFile(report, mCommon.reportPath);
+            mOutputs.add(mCommon.reportPath, [&](std::ostream& out) { out << report.dump(2) << '\n'; });
         }
+        mOutputs.commit();
         return code;
     } catch (const Error& e) {
         std::cerr << mName << ": error: " << e.what() << '\n';

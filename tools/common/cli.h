@@ -10,14 +10,15 @@
 #include <string>
 
 #include "zomefab/core/run_context.h"
+#include "zomefab/io/file_io.h"
 
 namespace zomefab::cli {
 
 struct CommonOptions {
-    int verbosity = 0;        ///< -1 quiet (errors only), 0 normal, 1 verbose (-v), 2 debug (-vv)
-    int threads = 0;          ///< 0 = all cores (TBB default)
-    uint64_t seed = 1;        ///< seed for every random choice; same seed, same output
-    std::string reportPath;   ///< --report FILE.json, empty = none
+    int verbosity = 0;       ///< -1 quiet (errors only), 0 normal, 1 verbose (-v), 2 debug (-vv)
+    int threads = 0;         ///< 0 = all cores (TBB default)
+    uint64_t seed = 1;       ///< seed for every random choice; same seed, same output
+    std::string reportPath;  ///< --report FILE.json, empty = none
 };
 
 /// One command-line tool. Declare options on `app()`, then `return tool.run(argc, argv, body)`.
@@ -35,6 +36,13 @@ public:
     /// the report (written to --report FILE atomically, with warnings added) and returns an exit code.
     int run(int argc, char** argv, const std::function<int(nlohmann::json& report)>& body);
 
+    /// Writes output @p path through @p write as part of this run's outputs: every file the run
+    /// writes (and its --report) is renamed into place only when the whole run succeeded; a
+    /// failure leaves none of them and touches no existing file. "-" writes stdout at once.
+    void writeOutput(const std::string& path, const std::function<void(std::ostream&)>& write) {
+        mOutputs.add(path, write);
+    }
+
     /// Adds `--in-format` / `--out-format`-style option that only accepts @p choices.
     CLI::Option* addFormatOption(const std::string& flag, std::string& target,
                                  const std::vector<std::string>& choices, const std::string& help);
@@ -44,6 +52,7 @@ private:
     CLI::App mApp;
     CommonOptions mCommon;
     std::unique_ptr<RunContext> mContext;
+    StagedFiles mOutputs;
     bool mQuiet = false;
     int mVerboseCount = 0;
 };

@@ -63,15 +63,7 @@ zome::Structure readFrame(const std::string& path, Transform4d* transformMm, con
 }
 
 partition::PartitionFile readPartition(const std::string& path) {
-    const nlohmann::json j = nlohmann::json::parse(readInputBytes(path), nullptr, false);
-    if (j.is_discarded()) throw Error(ErrorCode::InvalidInput, "invalid JSON", path);
-    try {
-        return partition::partitionFromJson(j);
-    } catch (const Error& e) {
-        throw e.withFile(path);
-    } catch (const nlohmann::json::exception& e) {
-        throw Error(ErrorCode::InvalidInput, std::string("malformed partition file: ") + e.what(), path);
-    }
+    return partition::parsePartitionFile(readInputBytes(path), path);
 }
 
 // --- what the user is making ----------------------------------------------------------------------

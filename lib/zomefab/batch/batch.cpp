@@ -90,8 +90,11 @@ json entrySummary(const BatchEntry& entry, int exitCode, double seconds, const s
 
 }  // namespace
 
-std::vector<BatchEntry> readManifest(const std::string& path) {
-    const json manifest = readJsonFile(path);
+std::vector<BatchEntry> readManifest(const std::string& path) { return parseManifest(readInputBytes(path), path); }
+
+std::vector<BatchEntry> parseManifest(std::string_view bytes, const std::string& path) {
+    const json manifest = json::parse(bytes, nullptr, false);
+    if (manifest.is_discarded()) throw Error(ErrorCode::InvalidInput, "invalid JSON", path);
     auto fail = [&](const std::string& what) { throw Error(ErrorCode::InvalidInput, what, path); };
     if (!manifest.is_object() || manifest.value("format", "") != kManifestFormatName)
         fail("not a batch manifest (expected \"format\": \"zomefab.batch\")");

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "zomefab/core/run_context.h"
@@ -27,6 +28,9 @@ struct BatchEntry {
 /// and "options" (merged over the defaults). Booleans become flags, lists repeat the option.
 /// @throw Error(InvalidInput) naming @p path and the entry.
 std::vector<BatchEntry> readManifest(const std::string& path);
+
+/// readManifest of the JSON text @p bytes; relative mesh paths are taken from @p path's directory.
+std::vector<BatchEntry> parseManifest(std::string_view bytes, const std::string& path);
 
 /// What every worker gets besides its entry: the executable to run (`zomefab`) and the options
 /// the batch itself was given that workers inherit (--seed, --threads, -q).

@@ -54,7 +54,12 @@ void checkOutputPath(const std::string& path) {
         throw Error(ErrorCode::WriteFailed, "directory is not writable: " + dir.string(), path);
 }
 
-void writeOutputAtomic(const std::string& path, const std::function<void(std::ostream&)>& write) {
+StagedFiles::~StagedFiles() {
+    std::error_code ec;
+    for (const auto& [temp, target] : mStaged) fs::remove(temp, ec);
+}
+
+void StagedFiles::add(const std::string& path, const std::function<void(std::ostream&)>& write) {
     if (path == "-") {
         write(std::cout);
         std::cout.flush();
@@ -63,25 +68,33 @@ void writeOutputAtomic(const std::string& path, const std::function<void(std::os
     }
     checkOutputPath(path);
     const fs::path target(path);
-    std::error_code ec;
     const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
     const fs::path temp = dir / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()));
-    try {
-        {
-            std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-            if (!out)
-                throw Error(ErrorCode::WriteFailed, std::string("cannot create: ") + std::strerror(errno),
-                            path);
-            write(out);
-            out.flush();
-            if (!out) throw Error(ErrorCode::WriteFailed, "write failed (disk full?)", path);
-        }
+    for (const auto& staged : mStaged)
+        if (staged.second == path)
+            throw Error(ErrorCode::Usage, "the same file is named as two outputs", path);
+    mStaged.emplace_back(temp.string(), path);  // removed by the destructor unless committed
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    if (!out)
+        throw Error(ErrorCode::WriteFailed, std::string("cannot create: ") + std::strerror(errno), path);
+    write(out);
+    out.flush();
+    if (!out) throw Error(ErrorCode::WriteFailed, "write failed (disk full?)", path);
+}
+
+void StagedFiles::commit() {
+    std::error_code ec;
+    for (const auto& [temp, target] : mStaged) {
         fs::rename(temp, target, ec);
-        if (ec) throw Error(ErrorCode::WriteFailed, "cannot rename into place: " + ec.message(), path);
-    } catch (...) {
-        fs::remove(temp, ec);
-        throw;
+        if (ec) throw Error(ErrorCode::WriteFailed, "cannot rename into place: " + ec.message(), target);
     }
+    mStaged.clear();
+}
+
+void writeOutputAtomic(const std::string& path, const std::function<void(std::ostream&)>& write) {
+    StagedFiles files;
+    files.add(path, write);
+    files.commit();
 }
 
 namespace {

@@ -5,6 +5,8 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace zomefab {
 
@@ -16,6 +18,27 @@ std::string readInputBytes(const std::string& path);
 /// failure never leaves a partial file. "-" writes to stdout directly (binary-safe).
 /// @throw Error(WriteFailed) naming the file; whatever @p write throws is rethrown after cleanup.
 void writeOutputAtomic(const std::string& path, const std::function<void(std::ostream&)>& write);
+
+/// Several output files written as one (a tool's main output, its --report, its --colored-ply):
+/// add() writes each into a temporary sibling, commit() renames them all into place. Without
+/// commit() (an error, Ctrl-C) the temporaries are removed and no existing file was touched, so a
+/// run that fails leaves none of its outputs. "-" writes stdout at once.
+class StagedFiles {
+public:
+    StagedFiles() = default;
+    ~StagedFiles();
+    StagedFiles(const StagedFiles&) = delete;
+    StagedFiles& operator=(const StagedFiles&) = delete;
+
+    /// Writes @p path's bytes through @p write into its temporary. @throw Error(WriteFailed) naming
+    /// the file (checkOutputPath's refusals included); whatever @p write throws is rethrown.
+    void add(const std::string& path, const std::function<void(std::ostream&)>& write);
+    /// Renames every temporary into place. @throw Error(WriteFailed)
+    void commit();
+
+private:
+    std::vector<std::pair<std::string, std::string>> mStaged;  ///< temporary, target
+};
 
 /// What writeOutputAtomic would refuse, checked before any work: @p path is a directory, its
 /// directory does not exist or is not writable, or it exists and is not a regular file (a device,

@@ -120,6 +120,11 @@ std::string oneLine(std::string s) {
     return s;
 }
 
+/// How many times over node instancing may repeat the vertices a file stores, and a floor below
+/// which any repetition is fine (a small part repeated many times is a real scene).
+constexpr uint64_t kMaxInstancing = 16;
+constexpr uint64_t kInstancingSlackVertices = 1u << 20;
+
 class GltfMeshBuilder {
 public:
     GltfMeshBuilder(const tinygltf::Model& model, const std::string& source)
@@ -129,6 +134,10 @@ public:
         for (const std::string& ext : mModel.extensionsRequired)
             if (ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression")
                 fail(mSource, "glTF uses " + ext + ", which zomefab cannot read; export it uncompressed");
+        // Nodes may use one mesh many times; a small file must not expand without bound.
+        uint64_t stored = 0;
+        for (size_t i = 0; i < mModel.meshes.size(); ++i) stored += storedVertices(int(i));
+        mVertexLimit = std::max(kMaxInstancing * stored, kInstancingSlackVertices);
         if (!mModel.scenes.empty()) {
             const int s = (mModel.defaultScene >= 0 && size_t(mModel.defaultScene) < mModel.scenes.size())
                               ? mModel.defaultScene
@@ -163,9 +172,27 @@ private:
         for (int child : node.children) addNode(child, world, depth + 1);
     }
 
+    /// Vertices the POSITION accessors of mesh @p index announce (readAccessor checks them later).
+    uint64_t storedVertices(int index) const {
+        uint64_t count = 0;
+        if (index < 0 || size_t(index) >= mModel.meshes.size()) return 0;
+        for (const tinygltf::Primitive& prim : mModel.meshes[size_t(index)].primitives) {
+            const auto position = prim.attributes.find("POSITION");
+            if (position != prim.attributes.end() && position->second >= 0 &&
+                size_t(position->second) < mModel.accessors.size())
+                count += std::min<uint64_t>(mModel.accessors[size_t(position->second)].count, UINT32_MAX);
+        }
+        return count;
+    }
+
     void addMesh(int index, const Matrix4& world) {
         if (index < 0 || size_t(index) >= mModel.meshes.size())
             fail(mSource, "glTF refers to mesh " + std::to_string(index) + ", which does not exist");
+        if (mMesh.positions.size() + storedVertices(index) > mVertexLimit)
+            fail(mSource, "glTF nodes use its meshes so often that they would expand to more than " +
+                              std::to_string(mVertexLimit) + " vertices (zomefab takes up to " +
+                              std::to_string(kMaxInstancing) +
+                              " times the vertices the file stores); flatten the scene in the exporter");
         const tinygltf::Mesh& mesh = mModel.meshes[size_t(index)];
         // A mirroring transform reverses the winding (glTF 2.0 spec, "Transformations").
         const bool mirrored = linearDeterminant(world) < 0;
@@ -363,6 +390,7 @@ private:
     const std::string& mSource;
     TriMesh mMesh;
     std::vector<char> mVisited;
+    uint64_t mVertexLimit = 0;  ///< what node instancing may expand the stored vertices to
 };
 
 /// Libdraco exports an older, layout-incompatible copy of the tinygltf symbols. When it precedes

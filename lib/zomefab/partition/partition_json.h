@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "zomefab/core/transform.h"
@@ -48,6 +49,10 @@ struct PartitionFile {
 /// complete, every index in range (cells of pieces, balls of cells) and every number finite.
 /// @throw Error(InvalidInput) naming the field (callers add the file).
 PartitionFile partitionFromJson(const nlohmann::json& document);
+
+/// partitionFromJson of the JSON text @p bytes (a partition.json as read from disk).
+/// @throw Error(InvalidInput) naming @p sourceName for invalid JSON or a malformed document.
+PartitionFile parsePartitionFile(std::string_view bytes, const std::string& sourceName);
 
 /// Binary little-endian PLY of @p meshMm with `uchar red, green, blue` and `int group` per face:
 /// @p faceGroups (piece, cell or label ids) coloured by a golden-ratio hue walk, so neighbouring

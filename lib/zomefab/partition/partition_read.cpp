@@ -134,4 +134,16 @@ PartitionFile partitionFromJson(const json& j) {
     return file;
 }
 
+PartitionFile parsePartitionFile(std::string_view bytes, const std::string& sourceName) {
+    const json j = json::parse(bytes, nullptr, false);
+    if (j.is_discarded()) throw Error(ErrorCode::InvalidInput, "invalid JSON", sourceName);
+    try {
+        return partitionFromJson(j);
+    } catch (const Error& e) {
+        throw e.withFile(sourceName);
+    } catch (const json::exception& e) {
+        throw Error(ErrorCode::InvalidInput, std::string("malformed partition file: ") + e.what(), sourceName);
+    }
+}
+
 }  // namespace zomefab::partition

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 
 #include "zomefab/pieces/pieces.h"
 
@@ -50,6 +51,10 @@ void writePieces(const Pieces& pieces, const std::string& directory, const Piece
 /// @throw Error(InvalidInput) naming the field (callers add the file) for a document that is not
 /// `zomefab.pieces` version 1, a missing or malformed field, or a piece file that cannot be read.
 Pieces piecesFromJson(const nlohmann::json& document, const std::string& directory);
+
+/// piecesFromJson of the JSON text @p bytes. @throw Error(InvalidInput) naming @p sourceName for
+/// invalid JSON or a malformed document.
+Pieces parsePieces(std::string_view bytes, const std::string& sourceName, const std::string& directory);
 
 /// Reads @p path (a pieces.json, or a directory holding one) with piecesFromJson, the meshes from
 /// its directory. @throw Error(InvalidInput) naming the file.

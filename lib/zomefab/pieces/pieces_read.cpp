@@ -265,19 +265,23 @@ Pieces piecesFromJson(const json& j, const std::string& directory) {
     return out;
 }
 
+Pieces parsePieces(std::string_view bytes, const std::string& sourceName, const std::string& directory) {
+    const json j = json::parse(bytes, nullptr, false);
+    if (j.is_discarded()) throw Error(ErrorCode::InvalidInput, "invalid JSON", sourceName);
+    try {
+        return piecesFromJson(j, directory);
+    } catch (const Error& e) {
+        throw e.withFile(sourceName);
+    } catch (const json::exception& e) {
+        throw Error(ErrorCode::InvalidInput, std::string("malformed pieces file: ") + e.what(), sourceName);
+    }
+}
+
 Pieces readPieces(const std::string& path) {
     std::error_code ec;
     const std::string file = fs::is_directory(path, ec) ? (fs::path(path) / kPiecesFile).string() : path;
-    const json j = json::parse(readInputBytes(file), nullptr, false);
-    if (j.is_discarded()) throw Error(ErrorCode::InvalidInput, "invalid JSON", file);
-    try {
-        return piecesFromJson(
-            j, fs::path(file).parent_path().string().empty() ? "." : fs::path(file).parent_path().string());
-    } catch (const Error& e) {
-        throw e.withFile(file);
-    } catch (const json::exception& e) {
-        throw Error(ErrorCode::InvalidInput, std::string("malformed pieces file: ") + e.what(), file);
-    }
+    const std::string directory = fs::path(file).parent_path().string();
+    return parsePieces(readInputBytes(file), file, directory.empty() ? "." : directory);
 }
 
 }  // namespace zomefab::pieces

@@ -12,7 +12,9 @@
 #include <sstream>
 
 #include "zomefab/core/error.h"
+#include "zomefab/core/format.h"
 #include "zomefab/sdf/level_set_grid.h"
+#include "zomefab/sdf/vdb_check.h"
 #include "zomefab/sdf/vdb_file.h"
 
 namespace zomefab::sdf {
@@ -65,39 +67,6 @@ void writeInfoMetadata(openvdb::FloatGrid& grid, const LevelSetInfo& info) {
     grid.insertMeta(kTransformKey, openvdb::Mat4DMetadata(toVdbMatrix(info.transformMm)));
 }
 
-/// FNV-1a, 64 bits: a content hash for the deterministic archive UUID.
-uint64_t fnv1a(const char* data, size_t size, uint64_t hash = 1469598103934665603ull) {
-    for (size_t i = 0; i < size; ++i) {
-        hash ^= uint8_t(data[i]);
-        hash *= 1099511628211ull;
-    }
-    return hash;
-}
-
-// The .vdb header (openvdb/io/Archive.cc, writeHeader): int64 magic, uint32 file version,
-// uint32 library major, uint32 library minor, char "has grid offsets", then the UUID as 36 ASCII
-// characters.
-constexpr size_t kUuidOffset = 8 + 4 + 4 + 4 + 1;
-constexpr size_t kUuidLength = 36;
-
-/// Replaces OpenVDB's random archive UUID by one derived from the rest of the bytes, so the same
-/// grids always give the same file (the project's determinism rule).
-void makeUuidDeterministic(std::string& bytes) {
-    if (bytes.size() < kUuidOffset + kUuidLength || bytes[kUuidOffset + 8] != '-') {
-        throw Error(ErrorCode::Internal, "unexpected .vdb header layout from OpenVDB");
-    }
-    const char* body = bytes.data() + kUuidOffset + kUuidLength;
-    const size_t bodySize = bytes.size() - kUuidOffset - kUuidLength;
-    const uint64_t h1 = fnv1a(body, bodySize);
-    const uint64_t h2 = fnv1a(body, bodySize, h1 ^ 0x9e3779b97f4a7c15ull);
-    char uuid[kUuidLength + 1];
-    // Version-4-like layout: 8-4-4-4-12 hexadecimal digits.
-    std::snprintf(uuid, sizeof(uuid), "%08x-%04x-%04x-%04x-%012llx", unsigned(h1 >> 32),
-                  unsigned((h1 >> 16) & 0xffff), unsigned(h1 & 0xffff), unsigned(h2 >> 48),
-                  static_cast<unsigned long long>(h2 & 0xffffffffffffull));
-    std::memcpy(&bytes[kUuidOffset], uuid, kUuidLength);
-}
-
 template <typename MetaT, typename ValueT>
 bool readMeta(const openvdb::GridBase& grid, const char* key, ValueT& value) {
     const auto meta = grid.getMetadata<MetaT>(key);
@@ -117,6 +86,13 @@ LevelSet levelSetFromGrid(openvdb::FloatGrid::Ptr grid, const std::string& sourc
                     "grid '" + gridName + "' has a " + xform.mapType() +
                         " transform; only uniform voxels without rotation are supported",
                     sourceName);
+    }
+    // Blosc-compressed voxel values are only seen once decompressed: a NaN or infinite distance
+    // would poison every stage after this one.
+    for (auto it = grid->tree().cbeginValueAll(); it; ++it) {
+        if (!std::isfinite(*it))
+            throw Error(ErrorCode::InvalidInput, "grid '" + gridName + "' holds a non-finite distance value",
+                        sourceName);
     }
     LevelSetInfo info;
     info.name = grid->getName();
@@ -235,12 +211,15 @@ std::string serializeVdb(const std::vector<LevelSet>& levelSets) {
     try {
         openvdb::io::Stream stream(buffer);
         stream.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
-        stream.write(grids);
+        // The checksum entry, filled in by sealVdbStream once the bytes are known.
+        openvdb::MetaMap fileMeta;
+        fileMeta.insertMeta(detail::kVdbChecksumKey, openvdb::StringMetadata("00000000"));
+        stream.write(grids, fileMeta);
     } catch (const openvdb::Exception& e) {
         throw Error(ErrorCode::WriteFailed, std::string("cannot serialize the grids: ") + e.what());
     }
     std::string bytes = std::move(buffer).str();
-    makeUuidDeterministic(bytes);
+    detail::sealVdbStream(bytes);
     return bytes;
 }
 
@@ -254,9 +233,20 @@ std::vector<LevelSet> parseVdb(std::string_view bytes, const std::string& source
     ensureOpenVdbInitialized();
     if (bytes.empty())
         throw Error(ErrorCode::InvalidInput, "empty input, expected a .vdb stream", sourceName);
+    // Every size checked (and zomefab's checksum) before OpenVDB trusts them.
+    detail::VdbCheck checked = detail::checkVdbStream(bytes, sourceName);
+    const double budget = memoryBudgetBytes(0);
+    if (double(checked.treeBytes) > budget) {
+        throw Error(
+            ErrorCode::ProcessingFailed,
+            formatNumbers("its grids would need about %.1f GB of memory, more than the %.1f GB budget "
+                          "(75 %% of this machine's)",
+                          double(checked.treeBytes) / 1e9, budget / 1e9),
+            sourceName);
+    }
     openvdb::GridPtrVecPtr grids;
     try {
-        std::istringstream in{std::string(bytes)};
+        std::istringstream in{std::move(checked.sanitized)};
         openvdb::io::Stream stream(in, /*delayLoad=*/false);
         grids = stream.getGrids();
     } catch (const std::exception& e) {
