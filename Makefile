@@ -41,7 +41,7 @@ test: test-deps $(BUILD_DIR)/CMakeCache.txt
 demo: build
 	./tools/demo.sh $(BUILD_DIR) $(DEMO_DIR)
 
-# libFuzzer targets for the mesh readers (clang); run one with e.g. build-fuzz/fuzz/fuzz_stl -max_total_time=300
+# libFuzzer targets for every reader of an untrusted file (clang, ASan + UBSan); tools/fuzz-all.sh runs them
 fuzz:
 	@./tools/install-deps.sh $(BUILD_PACKAGES) clang libclang-rt-14-dev
 	CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DZOMEFAB_FUZZ=ON \

@@ -516,6 +516,30 @@ TEST_CASE("orientation: a piece no cut face can carry rests on its largest side,
     CHECK(e.filamentMm3 > 0);
 }
 
+TEST_CASE("orientation: support decides: a shelf piece lies on its flat top, not on its cut face") {
+    // A 10 mm slab standing on its cut face (x in [0, 10], 60 × 60 mm) carries a 50 mm shelf at the
+    // top: on the cut face, the shelf's underside overhangs 50 mm above the bed (150 cm³ of
+    // columns); upside down, the top (3,600 mm²) is the base and nothing overhangs.
+    TriMesh shelf = zomefab::test::makeBox({0, 0, 0}, {10, 60, 60});
+    appendMesh(shelf, zomefab::test::makeBox({10, 0, 50}, {60, 60, 60}));
+    const std::vector<CutFace> faces = {{{0, 0, -1}, 0.0, 10 * 60}};
+    const SupportEstimate onCutFace = estimateSupport(shelf, {0, 0, -1});
+    CHECK(onCutFace.areaMm2 == doctest::Approx(50 * 60));
+    CHECK(onCutFace.volumeMm3 == doctest::Approx(50 * 60 * 50).epsilon(0.05));  // 2 mm cells
+    const PrintOrientation o = orientForPrinter(shelf, faces, {200, 200, 200});
+    CHECK(o.fits);
+    CHECK(!o.isCutFaceDown);
+    CHECK(o.downNormal[2] == doctest::Approx(1.0));
+    CHECK(o.support.volumeMm3 == doctest::Approx(0.0));
+    CHECK(o.baseAreaMm2 == doctest::Approx(60 * 60));
+    INFO(o.note);
+    CHECK(o.note.find("needs 150 cm³ of support against 0 cm³ this way") != std::string::npos);
+    // Columns stop on the piece below: a shelf over a floor needs only the gap between them.
+    TriMesh table = shelf;
+    appendMesh(table, zomefab::test::makeBox({10, 0, 0}, {60, 60, 10}));
+    CHECK(estimateSupport(table, {0, 0, -1}).volumeMm3 == doctest::Approx(50 * 60 * 40).epsilon(0.05));
+}
+
 TEST_CASE("label: seven-segment strokes, an underline, centred") {
     LabelOptions o;
     const auto eight = labelStrokes("8", o);

@@ -105,7 +105,8 @@ TEST_CASE("pieces: the union of the pieces is the shell (volume and sampled poin
     double total = 0;
     for (const Piece& p : result.pieces) {
         total += p.volumeMm3;
-        CHECK(p.isCutFaceDown);
+        CHECK(p.baseAreaMm2 >= 50.0);  // orientForPrinter's smallest first layer
+        CHECK(p.isBrimAdvised == (p.baseAreaMm2 < kBrimBelowMm2));
         CHECK(p.cells.size() == 1);
         CHECK(p.requests == p.cells);
     }

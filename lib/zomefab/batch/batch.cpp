@@ -90,11 +90,13 @@ json entrySummary(const BatchEntry& entry, int exitCode, double seconds, const s
 
 }  // namespace
 
-std::vector<BatchEntry> readManifest(const std::string& path) { return parseManifest(readInputBytes(path), path); }
+std::vector<BatchEntry> readManifest(const std::string& path) {
+    return parseManifest(readInputBytes(path), path);
+}
 
-std::vector<BatchEntry> parseManifest(std::string_view bytes, const std::string& path) {
-    const json manifest = json::parse(bytes, nullptr, false);
-    if (manifest.is_discarded()) throw Error(ErrorCode::InvalidInput, "invalid JSON", path);
+namespace {
+
+std::vector<BatchEntry> manifestFromJson(const json& manifest, const std::string& path) {
     auto fail = [&](const std::string& what) { throw Error(ErrorCode::InvalidInput, what, path); };
     if (!manifest.is_object() || manifest.value("format", "") != kManifestFormatName)
         fail("not a batch manifest (expected \"format\": \"zomefab.batch\")");
@@ -113,6 +115,19 @@ std::vector<BatchEntry> parseManifest(std::string_view bytes, const std::string&
             fail("entry " + std::to_string(i) + ": duplicate name \"" + entries.back().name + "\"");
     }
     return entries;
+}
+
+}  // namespace
+
+std::vector<BatchEntry> parseManifest(std::string_view bytes, const std::string& path) {
+    const json manifest = json::parse(bytes, nullptr, false);
+    if (manifest.is_discarded()) throw Error(ErrorCode::InvalidInput, "invalid JSON", path);
+    try {
+        return manifestFromJson(manifest, path);
+    } catch (const json::exception& e) {
+        // A member of the wrong type ("format": 5, found by fuzz_manifest).
+        throw Error(ErrorCode::InvalidInput, std::string("malformed manifest: ") + e.what(), path);
+    }
 }
 
 json runEntry(const WorkerCommand& command, const std::vector<BatchEntry>& entries, size_t index,

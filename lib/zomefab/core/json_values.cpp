@@ -26,6 +26,15 @@ double numberFromJson(const json& j, const std::string& what) {
     return x;
 }
 
+size_t countFromJson(const json& j, const char* key, size_t fallback) {
+    if (!j.is_object() || !j.contains(key)) return fallback;
+    const json& v = j[key];
+    if (v.is_number_unsigned()) return v.get<size_t>();
+    // Parsed text gives unsigned numbers; a json built in C++ from an int is signed.
+    if (v.is_number_integer() && v.get<int64_t>() >= 0) return size_t(v.get<int64_t>());
+    throw Error(ErrorCode::InvalidInput, std::string(key) + " must be a count");
+}
+
 Vec3d vec3FromJson(const json& j, const std::string& what) {
     if (!j.is_array() || j.size() != 3)
         throw Error(ErrorCode::InvalidInput, what + " must be an array of 3 numbers");

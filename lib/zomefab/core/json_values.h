@@ -21,6 +21,10 @@ nlohmann::json toJson(const Transform4d& t);
 
 /// A finite number. @throw Error(InvalidInput) "<what> must be a finite number".
 double numberFromJson(const nlohmann::json& j, const std::string& what);
+/// The count @p key of the object @p j, or @p fallback when absent. Counts are unsigned integers:
+/// nlohmann would cast a float or a negative number (5.6e99, found by fuzz_partition) to size_t,
+/// undefined behaviour. @throw Error(InvalidInput) "<key> must be a count".
+size_t countFromJson(const nlohmann::json& j, const char* key, size_t fallback);
 /// [x, y, z]. @throw Error(InvalidInput) "<what> must be an array of 3 numbers".
 Vec3d vec3FromJson(const nlohmann::json& j, const std::string& what);
 /// {"min": [...], "max": [...]}.

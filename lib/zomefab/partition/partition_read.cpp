@@ -117,7 +117,7 @@ PartitionFile partitionFromJson(const json& j) {
         file.info.transformMm = transformFromJson(j["transform_mm"], "transform_mm");
     if (j.contains("mesh") && j["mesh"].is_object()) {
         file.info.meshFile = j["mesh"].value("file", "");
-        file.info.vertexCount = j["mesh"].value("vertices", size_t(0));
+        file.info.vertexCount = countFromJson(j["mesh"], "vertices", 0);
     }
     if (j.contains("frame") && j["frame"].is_object()) {
         file.info.frameFile = j["frame"].value("file", "");

@@ -32,13 +32,14 @@ std::vector<CutFace> cutPlanes(const GridCells& cells, const CellSet& set, doubl
 
 [[noreturn]] void failFit(const Piece& piece, const PrintOrientation& orientation, const Vec3d& printerMm) {
     const Vec3d e = orientation.extentsMm;
-    throw Error(ErrorCode::ProcessingFailed,
-                "piece " + std::to_string(piece.id) + " (" + formatNumber(e[0], 4) + " × " +
-                    formatNumber(e[1], 4) + " × " + formatNumber(e[2], 4) + " mm at best) fits the " +
-                    formatNumber(printerMm[0], 4) + " × " + formatNumber(printerMm[1], 4) + " × " +
-                    formatNumber(printerMm[2], 4) +
-                    " mm printer in no orientation: the partition must cut it smaller (zf-partition "
-                    "--printer-mm, --fit-margin-mm)");
+    const double overshootMm = std::max({e[0] - printerMm[0], e[1] - printerMm[1], e[2] - printerMm[2], 0.0});
+    throw PieceTooLarge("piece " + std::to_string(piece.id) + " (" + formatNumber(e[0], 4) + " × " +
+                            formatNumber(e[1], 4) + " × " + formatNumber(e[2], 4) + " mm at best) fits the " +
+                            formatNumber(printerMm[0], 4) + " × " + formatNumber(printerMm[1], 4) + " × " +
+                            formatNumber(printerMm[2], 4) +
+                            " mm printer in no orientation: the partition must cut it smaller (zf-partition "
+                            "--printer-mm, --fit-margin-mm)",
+                        overshootMm);
 }
 
 /// The cut face on the bed made exactly flat: where the mesher's rounding put a vertex up to the
@@ -85,12 +86,15 @@ std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, cons
     piece.isCutFaceDown = orientation.isCutFaceDown;
     piece.downNormalGridMm = orientation.downNormal;
     piece.baseAreaMm2 = orientation.baseAreaMm2;
+    piece.supportAreaMm2 = orientation.support.areaMm2;
+    piece.supportVolumeMm3 = orientation.support.volumeMm3;
     piece.extentsMm = orientation.extentsMm;
     transformInPlace(mesh, orientation.transformMm);
     if (orientation.isCutFaceDown) {
         flattenBase(mesh, faces, orientation, piece);
         piece.baseAreaMm2 = baseAreaMm2(mesh, {0, 0, -1});
     }
+    piece.isBrimAdvised = piece.baseAreaMm2 < kBrimBelowMm2;
     // The adaptive mesher can emit two points a float's rounding apart (seen where a tenon off the
     // lattice axes meets a curved wall); turned onto the bed they can round to the same point.
     // Welded, the zero-area triangles between them repeat a vertex and go, so the STL has no

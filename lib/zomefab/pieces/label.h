@@ -16,15 +16,15 @@ namespace zomefab::pieces {
 /// Size and placement rules of the engraved number.
 struct LabelOptions {
     bool isEnabled = true;
-    double heightMm = 12.0;    ///< digit height
+    double heightMm = 12.0;  ///< digit height
     /// Line width (and the gap above the underline); at least 2 voxels, else labels are skipped
     /// with a warning: 2.4 mm keeps the digits legible at the default 1 mm voxel.
     double strokeMm = 2.4;
-    double depthMm = 1.2;      ///< engraving depth below the inner surface
+    double depthMm = 1.2;  ///< engraving depth below the inner surface
     /// The surface may leave the label's plane by this much under the label (so the engraving is
     /// between depthMm − flatnessMm and depthMm + flatnessMm deep).
     double flatnessMm = 0.6;
-    double marginMm = 2.0;     ///< clear distance to cut faces, wall edges and tenons
+    double marginMm = 2.0;  ///< clear distance to cut faces, wall edges and tenons
 };
 
 /// @throw Error(Usage) naming the option when a value is out of range.
@@ -68,14 +68,16 @@ struct SurfaceSpot {
 /// Inner-surface spots of every piece: where rays from the frame's balls along all 62 hole
 /// directions first meet the shell, within @p maxDistanceMm of the ball. Indexed by piece.
 std::vector<std::vector<SurfaceSpot>> innerSurfaceSpots(const zome::Structure& frame,
-                                                        const Transform4d& frameToGridMm, const ShellProbe& probe,
-                                                        size_t pieceCount, double maxDistanceMm);
+                                                        const Transform4d& frameToGridMm,
+                                                        const ShellProbe& probe, size_t pieceCount,
+                                                        double maxDistanceMm);
 
 /// The best spot of @p spots for @p text on piece @p piece: the flattest where the label and its
 /// margin lie on the piece's inner surface, inside its wall and clear of @p tenons. nullopt, with
 /// the reason in @p note, when there is none.
-std::optional<PieceLabel> placeLabel(const std::string& text, uint32_t piece, const std::vector<SurfaceSpot>& spots,
-                                     const std::vector<Tenon>& tenons, const TenonOptions& tenonOptions,
-                                     const ShellProbe& probe, const LabelOptions& options, std::string* note);
+std::optional<PieceLabel> placeLabel(const std::string& text, uint32_t piece,
+                                     const std::vector<SurfaceSpot>& spots, const std::vector<Tenon>& tenons,
+                                     const TenonOptions& tenonOptions, const ShellProbe& probe,
+                                     const LabelOptions& options, std::string* note);
 
 }  // namespace zomefab::pieces

@@ -9,28 +9,13 @@
 
 #include "zomefab/core/vec.h"
 #include "zomefab/pieces/detail/box_distance.h"
+#include "zomefab/pieces/detail/support.h"
 
 namespace zomefab::pieces {
 
 using namespace detail;
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-/// Rows of a rotation taking @p down (unit) to (0, 0, −1).
-std::array<Vec3d, 3> rotationDown(const Vec3d& down) {
-    const Vec3d z = scale(down, -1.0);
-    // A deterministic perpendicular: cross with the axis least aligned with z.
-    int least = 0;
-    for (int k = 1; k < 3; ++k)
-        if (std::abs(z[size_t(k)]) < std::abs(z[size_t(least)])) least = k;
-    Vec3d helper{0, 0, 0};
-    helper[size_t(least)] = 1.0;
-    const Vec3d x = normalized(cross(helper, z));
-    const Vec3d y = cross(z, x);
-    return {x, y, z};
-}
 
 /// Convex hull (Andrew's monotone chain) of 2D points, counter-clockwise.
 std::vector<std::array<double, 2>> convexHull(std::vector<std::array<double, 2>> p) {
@@ -105,29 +90,6 @@ Candidate evaluate(const std::vector<Vec3d>& points, const Vec3d& down, const Ve
     }
     c.placement = bestTurn(convexHull(std::move(projected)), z1 - z0, printer);
     return c;
-}
-
-/// The mesh in double precision, with each triangle's vector area (area × unit outward normal).
-struct MeshD {
-    std::vector<Vec3d> points;
-    std::vector<Triangle> triangles;
-    std::vector<Vec3d> vectorArea;
-    explicit MeshD(const TriMesh& m) : triangles(m.triangles) {
-        points.reserve(m.positions.size());
-        for (const Vec3f& p : m.positions) points.push_back(toD(p));
-        vectorArea.reserve(triangles.size());
-        for (const Triangle& t : triangles) {
-            const Vec3d& a = points[t[0]];
-            vectorArea.push_back(scale(cross(sub(points[t[1]], a), sub(points[t[2]], a)), 0.5));
-        }
-    }
-};
-
-/// The smallest coordinate of the mesh's points along @p up, mm.
-double lowestAlong(const MeshD& m, const Vec3d& up) {
-    double lowest = 1e300;
-    for (const Vec3d& p : m.points) lowest = std::min(lowest, dot(up, p));
-    return lowest;
 }
 
 /// The part of a triangle (corners @p v, heights @p z along "up") at or below @p top: a convex
@@ -211,6 +173,9 @@ const double kSameDirectionCos = std::cos(kPi / 180.0);
 constexpr size_t kFacetDirections = 128;
 /// How many of the best directions are refined by tilting.
 constexpr size_t kRefineStarts = 4;
+/// How many of the directions needing the least support (by the cheap estimate) are refined and
+/// measured by supportColumnsMm3.
+constexpr size_t kSupportStarts = 8;
 
 /// The outward normals of the largest facets, at most kFacetDirections, no two within 1°.
 std::vector<Vec3d> facetDirections(const MeshD& m) {
@@ -241,34 +206,199 @@ std::vector<Vec3d> sphereDirections() {
     return directions;
 }
 
-/// Hill-climbs contactMm2 from @p down by tilts of 2° down to 0.1° about two perpendicular axes,
-/// keeping to directions where @p fits; @p contact is contactMm2 at @p down on entry and at the
-/// result on return.
+/// Hill-climbs contactMm2 from @p down by tilts of 2° down to 0.1°, keeping to directions where
+/// @p fits; @p contact is contactMm2 at @p down on entry and at the result on return.
 template <class Fits>
 Vec3d tiltTowardsLargerBase(const MeshD& m, Vec3d down, double& contact, Fits&& fits) {
-    for (const double stepDeg : {2.0, 1.0, 0.5, 0.25, 0.1}) {
-        const double step = std::tan(stepDeg * kPi / 180.0);
-        for (int iteration = 0; iteration < 10; ++iteration) {
-            const std::array<Vec3d, 3> rows = rotationDown(down);
-            std::vector<std::pair<double, Vec3d>> larger;  // the tilts that enlarge the contact
-            for (const Vec3d& side : {rows[0], scale(rows[0], -1.0), rows[1], scale(rows[1], -1.0)}) {
-                const Vec3d d = normalized(madd(down, step, side));
-                const double a = contactMm2(m, d, kBaseHeightMm);
-                if (a > contact * (1.0 + 1e-9) + 1e-9) larger.push_back({a, d});
+    double negative = -contact;
+    down = tiltTowardsLess(
+        down, negative, [&](const Vec3d& d) { return -contactMm2(m, d, kBaseHeightMm); }, fits,
+        {2.0, 1.0, 0.5, 0.25, 0.1}, 10);
+    contact = -negative;
+    return down;
+}
+
+/// The smallest first layer a resting orientation may have (a 7 × 7 mm patch): below it slicers
+/// find little to extrude in the first layer, and the piece's hold on the bed is its supports'.
+constexpr double kMinBaseMm2 = 50.0;
+/// What a first layer below kBrimBelowMm2 costs in the orientation score, per mm² missing, in mm³
+/// of support columns: a 50 mm² base costs 88 cm³ of columns (about 20 cm³ of sparse support), so
+/// a piece rests on little only where that saves much more support.
+constexpr double kContactPenaltyMm3PerMm2 = 250.0;
+
+/// Between orientations needing the same support, the larger first layer wins (a bar lies on its
+/// side, not on its end).
+constexpr double kBaseTieBreakMm3PerMm2 = 0.01;
+
+/// A cut face on the bed is kept unless resting elsewhere saves more than this share of its
+/// support and this volume: a flat first layer is worth a little support.
+constexpr double kCutFaceSupportShare = 0.9;
+constexpr double kCutFaceSupportSlackMm3 = 2000.0;
+
+/// orientForPrinter's search over one piece (docs/pieces.md, "Orientation").
+class OrientationSearch {
+public:
+    OrientationSearch(const TriMesh& meshMm, const std::vector<CutFace>& cutFaces, const Vec3d& printer,
+                      double flatToleranceMm)
+        : mesh(meshMm), cutFaces(cutFaces), printer(printer), flatToleranceMm(flatToleranceMm) {
+        for (const CutFace& f : cutFaces) directions.push_back(f.outwardNormal);
+        for (const Vec3d& d : facetDirections(mesh)) directions.push_back(d);
+        searchStart = directions.size();
+        for (const Vec3d& d : sphereDirections()) directions.push_back(d);
+    }
+
+    bool fits(const Vec3d& d) const { return evaluate(mesh.points, d, printer).placement.ratio <= 1.0; }
+    bool hasFirstLayer(const Vec3d& d) const { return sectionArea(mesh, d, kBaseHeightMm) >= kMinBaseMm2; }
+    /// Support volume plus what a small first layer costs (kContactPenaltyMm3PerMm2 below a brim's
+    /// worth of base), less a tie-break for the larger base.
+    double score(const Vec3d& d) const {
+        const double base = sectionArea(mesh, d, kBaseHeightMm);
+        return supportColumnsMm3(mesh, d) + kContactPenaltyMm3PerMm2 * std::max(0.0, kBrimBelowMm2 - base) -
+               kBaseTieBreakMm3PerMm2 * base;
+    }
+    /// How far the piece reaches beyond the plane of @p f, mm.
+    double beyondMm(const CutFace& f) const {
+        double beyond = -1e300;
+        for (const Vec3d& p : mesh.points) beyond = std::max(beyond, dot(f.outwardNormal, p) + f.offsetMm);
+        return beyond;
+    }
+
+    /// 1. Flat bases: the cut faces the whole piece lies behind (a piece made of several cells, a
+    /// merged sliver, may reach beyond the plane of one of its faces), not slivers, that fit; the
+    /// one scoring best. Counts why the others cannot (for the note).
+    void findFlatBase() {
+        for (const CutFace& f : cutFaces) {
+            const double beyond = beyondMm(f);
+            if (beyond > flatToleranceMm) {
+                ++behind;
+                leastBeyondMm = std::min(leastBeyondMm, beyond);
+            } else if (f.areaMm2 < kMinCutFaceAreaMm2) {
+                ++small;
+            } else if (!fits(f.outwardNormal)) {
+                ++tooLarge;
+            } else if (const double s = score(f.outwardNormal); s < baseScore) {
+                base = &f, baseScore = s;
             }
-            // Largest first; ties keep the order of the sides.
-            std::stable_sort(larger.begin(), larger.end(),
-                             [](const auto& x, const auto& y) { return x.first > y.first; });
-            bool isMoved = false;
-            for (const auto& [a, d] : larger)
-                if (fits(d)) {
-                    down = d, contact = a, isMoved = true;
-                    break;
-                }
-            if (!isMoved) break;
         }
     }
-    return down;
+
+    /// 2. Resting directions with a first layer: the kSupportStarts best-scored that fit, each
+    /// tilted by the cheap estimate (columns down to the bed) and kept where the score agrees.
+    void findResting() {
+        std::vector<std::pair<double, size_t>> byScore;  // least first
+        for (size_t i = 0; i < directions.size(); ++i)
+            if (hasFirstLayer(directions[i])) byScore.push_back({score(directions[i]), i});
+        std::sort(byScore.begin(), byScore.end());
+        std::vector<Vec3d> starts;
+        for (const auto& [score0, i] : byScore) {
+            if (starts.size() == kSupportStarts) break;
+            const Vec3d& direction = directions[i];  // (clang cannot capture a structured binding)
+            const bool isNear = std::any_of(starts.begin(), starts.end(), [&](const Vec3d& s) {
+                return dot(s, direction) > kSameDirectionCos;
+            });
+            if (isNear || !fits(direction)) continue;
+            starts.push_back(direction);
+            // Tilted by the cheap estimate (columns down to the bed), kept where the score agrees.
+            double support = supportOf(mesh, direction).volumeMm3;
+            const Vec3d tilted = tiltTowardsLess(
+                direction, support, [&](const Vec3d& d) { return supportOf(mesh, d).volumeMm3; },
+                [&](const Vec3d& d) { return hasFirstLayer(d) && fits(d); });
+            const double tiltedScore = score(tilted);
+            const double best = std::min(tiltedScore, score0);
+            if (best < restScore) restScore = best, rest = tiltedScore < score0 ? tilted : direction;
+        }
+        hasRest = !starts.empty();
+    }
+
+    /// 3. No direction has a first layer: the largest contact that fits, if any.
+    bool largestContact(Vec3d& down) const {
+        std::vector<std::pair<double, size_t>> byContact;  // (−contact, index): largest first
+        for (size_t i = 0; i < directions.size(); ++i)
+            byContact.push_back({-contactMm2(mesh, directions[i], kBaseHeightMm), i});
+        std::sort(byContact.begin(), byContact.end());
+        std::vector<Vec3d> starts;
+        double bestContact = -1.0;
+        for (const auto& [negContact, i] : byContact) {
+            if (starts.size() == kRefineStarts) break;
+            if (-negContact <= bestContact) break;  // tilting only enlarges: no later start can win
+            const Vec3d& direction = directions[i];
+            const bool isNear = std::any_of(starts.begin(), starts.end(), [&](const Vec3d& s) {
+                return dot(s, direction) > kSameDirectionCos;
+            });
+            if (isNear || !fits(direction)) continue;
+            starts.push_back(direction);
+            double contact = -negContact;
+            const Vec3d refined =
+                tiltTowardsLargerBase(mesh, direction, contact, [&](const Vec3d& d) { return fits(d); });
+            if (contact > bestContact) bestContact = contact, down = refined;
+        }
+        return bestContact >= 0;
+    }
+
+    /// 4. Nothing fits: the direction with the most room (the caller fails with it).
+    Vec3d mostRoom() const {
+        Vec3d down = directions[searchStart];
+        double ratio = 1e300;
+        for (size_t i = searchStart; i < directions.size(); ++i) {
+            const double r = evaluate(mesh.points, directions[i], printer).placement.ratio;
+            if (r < ratio - 1e-12) ratio = r, down = directions[i];
+        }
+        return down;
+    }
+
+    /// Why no cut face lies on the bed, and what the piece rests on instead.
+    std::string note(const PrintOrientation& out) const {
+        std::ostringstream note;
+        note.precision(4);
+        note << "no cut face on the bed (of " << cutFaces.size() << ": " << behind
+             << " with the piece beyond them";
+        if (behind > 0) note << " by " << leastBeyondMm << " mm or more";
+        if (!cutFaces.empty())
+            note << "; the largest, " << cutFaces[0].areaMm2 << " mm², has it "
+                 << std::max(0.0, beyondMm(cutFaces[0])) << " mm beyond";
+        note << ", " << small << " under " << kMinCutFaceAreaMm2 << " mm², " << tooLarge
+             << " too large for the printer";
+        if (base)
+            note << ", and the best that fits needs " << baseScore / 1000.0 << " cm³ of support against "
+                 << out.support.volumeMm3 / 1000.0 << " cm³ this way";
+        note << "); it rests on " << out.baseAreaMm2 << " mm²";
+        return note.str();
+    }
+
+    const MeshD mesh;
+    const std::vector<CutFace>& cutFaces;
+    const Vec3d printer;
+    const double flatToleranceMm;
+    std::vector<Vec3d> directions;  ///< cut-face normals, facet normals, then the sphere (searchStart)
+    size_t searchStart = 0;
+    const CutFace* base = nullptr;  ///< findFlatBase's choice
+    double baseScore = 1e300;
+    size_t behind = 0, small = 0, tooLarge = 0;  ///< cut faces that cannot be the base, and why
+    double leastBeyondMm = 1e300;
+    bool hasRest = false;  ///< findResting's choice
+    Vec3d rest{0, 0, -1};
+    double restScore = 1e300;
+};
+
+/// Fills @p out's transform, extents and fit for the piece resting on @p out.downNormal: turned
+/// about z for the most room, on the bed (z = 0), centred in x and y.
+void place(const MeshD& mesh, const Vec3d& printer, PrintOrientation& out) {
+    const Candidate chosen = evaluate(mesh.points, out.downNormal, printer);
+    const double ca = std::cos(chosen.placement.angleRad), sa = std::sin(chosen.placement.angleRad);
+    const Vec3d r0 = sub(scale(chosen.rows[0], ca), scale(chosen.rows[1], sa));
+    const Vec3d r1 = add(scale(chosen.rows[0], sa), scale(chosen.rows[1], ca));
+    const Vec3d& r2 = chosen.rows[2];
+    Box3d box;
+    for (const Vec3d& p : mesh.points) box.expand({dot(r0, p), dot(r1, p), dot(r2, p)});
+    const Vec3d t{0.5 * printer[0] - 0.5 * (box.min[0] + box.max[0]),
+                  0.5 * printer[1] - 0.5 * (box.min[1] + box.max[1]), -box.min[2]};
+    out.transformMm.m = {r0[0], r0[1], r0[2], t[0], r1[0], r1[1], r1[2], t[1],
+                         r2[0], r2[1], r2[2], t[2], 0,     0,     0,     1};
+    out.extentsMm = box.size();
+    out.ratio = std::max(
+        {out.extentsMm[0] / printer[0], out.extentsMm[1] / printer[1], out.extentsMm[2] / printer[2]});
+    out.fits = out.ratio <= 1.0;
+    out.baseAreaMm2 = sectionArea(mesh, out.downNormal, kBaseHeightMm);
 }
 
 }  // namespace
@@ -307,125 +437,29 @@ PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFa
                                   const Vec3d& printer, double flatToleranceMm) {
     PrintOrientation out;
     if (meshMm.positions.empty()) return out;
-    const MeshD mesh(meshMm);
-    const std::vector<Vec3d>& points = mesh.points;
-    Candidate chosen;
-    bool isChosen = false;
-    // Why no cut face went down (reported when none does).
-    size_t behind = 0, small = 0, tooLarge = 0;
-    double leastBeyondMm = 1e300;
-    auto beyondMm = [&](const CutFace& f) {
-        double beyond = -1e300;
-        for (const Vec3d& p : points) beyond = std::max(beyond, dot(f.outwardNormal, p) + f.offsetMm);
-        return beyond;
-    };
-    for (const CutFace& f : cutFaces) {
-        // Only a face the whole piece lies behind can rest on the bed: a piece made of several
-        // cells (a merged sliver) may reach beyond the plane of one of its faces.
-        const double beyond = beyondMm(f);
-        if (beyond > flatToleranceMm) {
-            ++behind;
-            leastBeyondMm = std::min(leastBeyondMm, beyond);
-            continue;
-        }
-        // A sliver of a face would hold the piece no better than a point: let the search decide.
-        if (f.areaMm2 < kMinCutFaceAreaMm2) {
-            ++small;
-            continue;
-        }
-        Candidate c = evaluate(points, f.outwardNormal, printer);
-        if (c.placement.ratio <= 1.0) {
-            chosen = c;
-            isChosen = true;
+    OrientationSearch search(meshMm, cutFaces, printer, flatToleranceMm);
+    search.findFlatBase();
+    search.findResting();
+    // A cut face wins unless resting elsewhere scores clearly better: a flat first layer is worth
+    // a little support.
+    if (search.base && (!search.hasRest || search.baseScore <= search.restScore / kCutFaceSupportShare +
+                                                                   kCutFaceSupportSlackMm3)) {
+        out.isCutFaceDown = true;
+        out.downNormal = search.base->outwardNormal;
+    } else if (search.hasRest) {
+        out.downNormal = search.rest;
+    } else if (!search.largestContact(out.downNormal)) {
+        out.downNormal = search.mostRoom();
+    }
+    // A cut face the piece lies behind may have won the search: it is still a cut face.
+    for (const CutFace& f : cutFaces)
+        if (!out.isCutFaceDown && dot(f.outwardNormal, out.downNormal) > 1.0 - 1e-12 &&
+            search.beyondMm(f) <= flatToleranceMm)
             out.isCutFaceDown = true;
-            out.downNormal = f.outwardNormal;
-            break;
-        }
-        ++tooLarge;
-    }
-    if (!isChosen) {
-        // No cut face can go down. The old rule, "the direction with the most room", put pieces on
-        // a corner or an edge (PrusaSlicer: "no extrusions in the first layer"). Instead: the
-        // largest contact with the bed that fits. The candidates are every direction a flat part
-        // of the piece faces (cut faces, even those the piece reaches beyond, and its largest
-        // facets) and a sphere of directions; the best few that fit are tilted in small steps
-        // towards a larger contact (a piece resting on several patches at once).
-        std::vector<Vec3d> directions;
-        for (const CutFace& f : cutFaces) directions.push_back(f.outwardNormal);
-        for (const Vec3d& d : facetDirections(mesh)) directions.push_back(d);
-        const size_t searchStart = directions.size();
-        for (const Vec3d& d : sphereDirections()) directions.push_back(d);
-        std::vector<std::pair<double, size_t>> byContact;  // (−contact, index): sorted, largest first
-        for (size_t i = 0; i < directions.size(); ++i)
-            byContact.push_back({-contactMm2(mesh, directions[i], kBaseHeightMm), i});
-        std::sort(byContact.begin(), byContact.end());
-        auto fits = [&](const Vec3d& d) { return evaluate(points, d, printer).placement.ratio <= 1.0; };
-        // A large piece may fit the printer only in a few orientations, none on a flat side: the
-        // starts are the best directions that fit.
-        std::vector<Vec3d> starts;
-        double bestContact = -1.0;
-        for (const auto& [negContact, i] : byContact) {
-            if (starts.size() == kRefineStarts) break;
-            if (-negContact <= bestContact) break;  // tilting only enlarges: no later start can win
-            const bool isNear = std::any_of(starts.begin(), starts.end(), [&](const Vec3d& s) {
-                return dot(s, directions[i]) > kSameDirectionCos;
-            });
-            if (isNear || !fits(directions[i])) continue;
-            starts.push_back(directions[i]);
-            double contact = -negContact;
-            const Vec3d refined = tiltTowardsLargerBase(mesh, directions[i], contact, fits);
-            if (contact > bestContact) {
-                bestContact = contact;
-                out.downNormal = refined;
-                isChosen = true;
-            }
-        }
-        if (isChosen) chosen = evaluate(points, out.downNormal, printer);
-        if (!isChosen) {
-            // Nothing fits: report the direction with the most room (the caller fails with it).
-            for (size_t i = searchStart; i < directions.size(); ++i) {
-                Candidate c = evaluate(points, directions[i], printer);
-                if (!isChosen || c.placement.ratio < chosen.placement.ratio - 1e-12) {
-                    chosen = c;
-                    isChosen = true;
-                    out.downNormal = directions[i];
-                }
-            }
-        }
-        // A small cut face the piece lies behind may have won the search: it is still a cut face.
-        for (const CutFace& f : cutFaces)
-            if (dot(f.outwardNormal, out.downNormal) > 1.0 - 1e-12 && beyondMm(f) <= flatToleranceMm)
-                out.isCutFaceDown = true;
-    }
-    // Rotation: turn about z by the angle after taking "down" to −z.
-    const double ca = std::cos(chosen.placement.angleRad), sa = std::sin(chosen.placement.angleRad);
-    const Vec3d r0 = sub(scale(chosen.rows[0], ca), scale(chosen.rows[1], sa));
-    const Vec3d r1 = add(scale(chosen.rows[0], sa), scale(chosen.rows[1], ca));
-    const Vec3d& r2 = chosen.rows[2];
-    Box3d box;
-    for (const Vec3d& p : points) box.expand({dot(r0, p), dot(r1, p), dot(r2, p)});
-    const Vec3d t{0.5 * printer[0] - 0.5 * (box.min[0] + box.max[0]),
-                  0.5 * printer[1] - 0.5 * (box.min[1] + box.max[1]), -box.min[2]};
-    out.transformMm.m = {r0[0], r0[1], r0[2], t[0], r1[0], r1[1], r1[2], t[1],
-                         r2[0], r2[1], r2[2], t[2], 0,     0,     0,     1};
-    out.extentsMm = box.size();
-    out.ratio = std::max(
-        {out.extentsMm[0] / printer[0], out.extentsMm[1] / printer[1], out.extentsMm[2] / printer[2]});
-    out.fits = out.ratio <= 1.0;
-    out.baseAreaMm2 = sectionArea(mesh, out.downNormal, kBaseHeightMm);
-    if (!out.isCutFaceDown) {
-        std::ostringstream note;
-        note.precision(4);
-        note << "no cut face on the bed (of " << cutFaces.size() << ": " << behind
-             << " with the piece beyond them";
-        if (behind > 0) note << " by " << leastBeyondMm << " mm or more";
-        if (!cutFaces.empty())
-            note << "; the largest, " << cutFaces[0].areaMm2 << " mm², has it "
-                 << std::max(0.0, beyondMm(cutFaces[0])) << " mm beyond";
-        note << ", " << small << " under " << kMinCutFaceAreaMm2 << " mm², " << tooLarge
-             << " too large for the printer); it rests on " << out.baseAreaMm2 << " mm²";
-        out.note = note.str();
-    }
+    out.support = {supportOf(search.mesh, out.downNormal).areaMm2,
+                   supportColumnsMm3(search.mesh, out.downNormal)};
+    place(search.mesh, printer, out);
+    if (!out.isCutFaceDown) out.note = search.note(out);
     return out;
 }
 

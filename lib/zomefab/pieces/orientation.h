@@ -23,7 +23,8 @@ struct CutFace {
 /// The planar faces of @p meshMm on the given planes: the triangles whose three vertices lie within
 /// @p toleranceMm of a plane and whose normal agrees with its outward normal. @p planes holds
 /// candidate planes (area ignored); the result keeps those with area, largest first.
-std::vector<CutFace> measureCutFaces(const TriMesh& meshMm, const std::vector<CutFace>& planes, double toleranceMm);
+std::vector<CutFace> measureCutFaces(const TriMesh& meshMm, const std::vector<CutFace>& planes,
+                                     double toleranceMm);
 
 /// Height above the bed at which a piece's base is measured: about one first layer (PrusaSlicer
 /// slices a 0.2–0.3 mm first layer at its middle). A piece whose cross-section there is a point
@@ -43,27 +44,49 @@ constexpr double kMinCutFaceAreaMm2 = 100.0;
 /// to point down. mm².
 double baseAreaMm2(const TriMesh& meshMm, const Vec3d& down, double heightMm = kBaseHeightMm);
 
+/// A facet facing down more steeply than this from the vertical needs support (the usual 45° rule;
+/// PrusaSlicer's automatic threshold at 0.3 mm layers is close to it).
+constexpr double kOverhangDeg = 45.0;
+/// A piece whose first layer is smaller than this is advised a brim (about a 20 × 20 mm base).
+constexpr double kBrimBelowMm2 = 400.0;
+
+/// What would need support were @p down (unit, the mesh's frame) to point down.
+struct SupportEstimate {
+    /// Facets facing down more steeply than kOverhangDeg from the vertical and above the first
+    /// layer: their area, mm².
+    double areaMm2 = 0.0;
+    /// The volume support columns under those facets fill, each from the first up-facing surface
+    /// of the piece below it or from the bed (a slicer builds supports on the model too), sampled
+    /// on a 2 mm grid, mm³. Solid: a slicer's sparse support uses a fraction of it.
+    double volumeMm3 = 0.0;
+};
+SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down);
+
 /// How a piece sits in the printer.
 struct PrintOrientation {
-    bool fits = false;              ///< inside the build volume
-    bool isCutFaceDown = false;     ///< a cut face lies on the bed
-    Vec3d downNormal{0, 0, -1};     ///< the outward normal (input frame) that points down
-    Transform4d transformMm;        ///< input mm → printer mm: on the bed (z = 0), centred in x and y
-    Vec3d extentsMm{0, 0, 0};       ///< size along the printer's x, y, z
-    double ratio = 0.0;             ///< max over axes of extent / printer size (≤ 1 fits)
-    double baseAreaMm2 = 0.0;       ///< baseAreaMm2() on the bed: the first layer's area
+    bool fits = false;           ///< inside the build volume
+    bool isCutFaceDown = false;  ///< a cut face lies on the bed
+    Vec3d downNormal{0, 0, -1};  ///< the outward normal (input frame) that points down
+    Transform4d transformMm;     ///< input mm → printer mm: on the bed (z = 0), centred in x and y
+    Vec3d extentsMm{0, 0, 0};    ///< size along the printer's x, y, z
+    double ratio = 0.0;          ///< max over axes of extent / printer size (≤ 1 fits)
+    double baseAreaMm2 = 0.0;    ///< baseAreaMm2() on the bed: the first layer's area
+    SupportEstimate support;     ///< estimateSupport() of the chosen orientation
     /// Why no cut face lies on the bed, and what the piece rests on instead; empty when one does.
     std::string note;
 };
 
 /// The orientation of the closed mesh @p meshMm (a piece) for a printer of @p printerMm (x, y =
-/// bed, z = height). Tries the cut faces of at least kMinCutFaceAreaMm2, largest first, that no
-/// vertex lies beyond by more than @p flatToleranceMm, each turned about the vertical for the best
-/// fit on the bed; the first that fits wins. Otherwise the piece rests where it touches the bed
-/// most: among the cut faces' normals, the normals of the mesh's largest facets and 256 sphere
-/// directions (the best few that fit refined by small tilts), the one that fits with the largest
-/// area of down-facing facets within kBaseHeightMm of the bed, weighted by their closeness to it.
-/// When nothing fits, the orientation with the most room, fits = false. Deterministic.
+/// bed, z = height), each direction turned about the vertical for the best fit on the bed. The
+/// candidates: the cut faces of at least kMinCutFaceAreaMm2 that no vertex lies beyond by more
+/// than @p flatToleranceMm (a flat base), and directions the piece rests on (the normals of the
+/// cut faces and of the mesh's largest facets, 256 sphere directions) with a first layer of at
+/// least 50 mm². Of those that fit, the one with the least support wins:
+/// each is scored by estimateSupport's volume (columns down to the piece below or the bed) plus a
+/// penalty for a first layer under kBrimBelowMm2; the best 8 resting directions are tilted in
+/// small steps towards less support. A cut face wins unless a resting direction scores clearly
+/// better (by 10 % and 2 cm³). When no direction has the first layer, the largest contact that
+/// fits; when nothing fits, the orientation with the most room, fits = false. Deterministic.
 PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFace>& cutFaces,
                                   const Vec3d& printerMm, double flatToleranceMm = kFlatToleranceMm);
 

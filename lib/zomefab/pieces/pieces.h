@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "zomefab/core/error.h"
 #include "zomefab/core/fabrication.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/core/transform.h"
@@ -112,15 +113,20 @@ struct Piece {
     /// layer prints. A cut face down gives its area; a piece with none rests on the largest base
     /// that fits (docs/pieces.md, "Orientation").
     double baseAreaMm2 = 0.0;
-    Vec3d extentsMm{0, 0, 0};  ///< size of the printed piece along the printer's x, y, z
-    double volumeMm3 = 0.0;    ///< of the mesh
-    Box3d gridBoundsMm;        ///< of the mesh in the shell grid's mm
+    /// What needs support printed this way (estimateSupport): the area of the facets facing down
+    /// more than 45° from the vertical, and the volume of support columns under them from the bed.
+    double supportAreaMm2 = 0.0;
+    double supportVolumeMm3 = 0.0;
+    bool isBrimAdvised = false;  ///< the first layer is under kBrimBelowMm2: print it with a brim
+    Vec3d extentsMm{0, 0, 0};    ///< size of the printed piece along the printer's x, y, z
+    double volumeMm3 = 0.0;      ///< of the mesh
+    Box3d gridBoundsMm;          ///< of the mesh in the shell grid's mm
 };
 
 /// The result of makePieces.
 struct Pieces {
     std::vector<Piece> pieces;
-    Vec3d printerMm = Fabrication{}.printerMm;  ///< the Fabrication's printer they were oriented for
+    Vec3d printerMm = Fabrication{}.printerMm;       ///< the Fabrication's printer they were oriented for
     double bedMarginMm = Fabrication{}.bedMarginMm;  ///< the Fabrication's, for the plates (plates.h)
     double voxelMm = 0.0;
     double shellVolumeMm3 = 0.0;  ///< the shell, counted in voxels
@@ -140,6 +146,15 @@ struct Pieces {
     double seconds = 0.0;
 };
 
+/// What makePieces throws when a piece fits the printer in no orientation: its region of the
+/// surface fitted (the partition's test), but the wall, tenons and pegs made it larger.
+class PieceTooLarge : public Error {
+public:
+    PieceTooLarge(const std::string& message, double overshootMm)
+        : Error(ErrorCode::ProcessingFailed, message), overshootMm(overshootMm) {}
+    double overshootMm;  ///< by how much its best orientation exceeds the printer, mm
+};
+
 /// @throw Error(ProcessingFailed) "the pieces cannot be put on the frame: ..." naming the plan's
 /// problems, when @p pieces' installation plan has any (a tool writes no such pieces).
 void requireBuildable(const Pieces& pieces);
@@ -155,9 +170,9 @@ void requireBuildable(const Pieces& pieces);
 ///                      pieces that share a cell (a cell whose surface falls into separate patches).
 /// @throw Error(Usage) for bad options or a voxel too coarse for the tenon pegs;
 ///        Error(InvalidInput) for an empty shell, a request naming an unknown cell, mismatched
-///        cell arrays, or a frameToGridMm that scales; Error(ProcessingFailed) when a piece fits
-///        the printer in no orientation (the partition must cut smaller), or a piece mesh is not
-///        closed; Error(Cancelled).
+///        cell arrays, or a frameToGridMm that scales; PieceTooLarge when a piece fits the
+///        printer in no orientation (the partition must cut smaller); Error(ProcessingFailed)
+///        when a piece mesh is not closed; Error(Cancelled).
 Pieces makePieces(const sdf::LevelSet& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
                   const partition::PartitionResult& partition, const Fabrication& fabrication,
                   const PiecesOptions& options, RunContext& context);

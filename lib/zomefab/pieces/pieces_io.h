@@ -38,9 +38,9 @@ nlohmann::json piecesToJson(const Pieces& pieces, const PiecesJsonInfo& info);
 /// @throw Error(WriteFailed) naming the file.
 void writePieceFiles(const Pieces& pieces, const std::string& directory, const PiecesJsonInfo& info);
 
-/// zf-pieces' output: writePieceFiles and the plates (plates/plate-NN.3mf, plates.h) into @p directory, through a temporary
-/// sibling that replaces @p directory only when all were written; an existing @p directory is
-/// replaced only when it is empty or an earlier output (it holds a pieces.json).
+/// zf-pieces' output: writePieceFiles and the plates (plates/plate-NN.3mf, plates.h) into @p directory,
+/// through a temporary sibling that replaces @p directory only when all were written; an existing @p
+/// directory is replaced only when it is empty or an earlier output (it holds a pieces.json).
 /// @throw Error(WriteFailed) naming the directory or file.
 void writePieces(const Pieces& pieces, const std::string& directory, const PiecesJsonInfo& info);
 

@@ -102,6 +102,12 @@ void readOrientation(const json& o, Piece& piece, const std::string& what) {
     piece.downNormalGridMm = optionalField(o, "down_normal", Vec3d{0, 0, -1}, vec("down_normal"));
     piece.baseAreaMm2 = optionalField(
         o, "base_area_mm2", 0.0, [&](const json& v) { return numberFromJson(v, what + ".base_area_mm2"); });
+    auto number = [&](const char* key) {
+        return [&, key](const json& v) { return numberFromJson(v, what + "." + key); };
+    };
+    piece.supportAreaMm2 = optionalField(o, "support_area_mm2", 0.0, number("support_area_mm2"));
+    piece.supportVolumeMm3 = optionalField(o, "support_volume_mm3", 0.0, number("support_volume_mm3"));
+    piece.isBrimAdvised = o.value("brim_advised", false);
     piece.extentsMm = optionalField(o, "extents_mm", Vec3d{0, 0, 0}, vec("extents_mm"));
 }
 
@@ -259,9 +265,9 @@ Pieces piecesFromJson(const json& j, const std::string& directory) {
     const json& summary = j.value("summary", json::object());
     out.shellVolumeMm3 = summary.value("shell_volume_mm3", 0.0);
     out.outsideCellsVolumeMm3 = summary.value("outside_cells_volume_mm3", 0.0);
-    out.sliversMerged = summary.value("slivers_merged", size_t(0));
-    out.isolatedSlivers = summary.value("isolated_slivers", size_t(0));
-    out.recutPieces = summary.value("recut_pieces", size_t(0));
+    out.sliversMerged = countFromJson(summary, "slivers_merged", 0);
+    out.isolatedSlivers = countFromJson(summary, "isolated_slivers", 0);
+    out.recutPieces = countFromJson(summary, "recut_pieces", 0);
     return out;
 }
 

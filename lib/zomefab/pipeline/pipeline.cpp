@@ -5,6 +5,7 @@
 #include "zomefab/core/format.h"
 #include "zomefab/core/version.h"
 #include "zomefab/frame/outermost.h"
+#include "zomefab/pieces/pieces.h"
 #include "zomefab/report/run_report.h"
 #include "zomefab/sdf/interior_field.h"
 #include "zomefab/zome/parts.h"
@@ -97,6 +98,32 @@ void makePieces(report::RunRecord& run, const RunOptions& options, RunContext& c
     run.plates = pieces::packPlates(run.pieces);
 }
 
+/// How often the partition runs again for a piece that came out too large.
+constexpr int kMaxRefits = 3;
+
+/// Stages 5 and 6. A piece is its region of the surface plus the wall, the tenons and the pegs
+/// inside it; now and then (seen at 700 mm: 3.1 mm) that is larger than the region the partition
+/// fitted to the printer. The partition then runs again with its fit margin grown by the overshoot
+/// (the margin grows each side of a region's box, so half of it, plus 1 mm), so the user gets
+/// pieces instead of an error.
+void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunContext& context) {
+    for (int refit = 0;; ++refit) {
+        partitionSurface(run, options, context);
+        try {
+            makePieces(run, options, context);
+            return;
+        } catch (const pieces::PieceTooLarge& e) {
+            if (refit == kMaxRefits) throw;
+            const double before = run.fabrication.fitMarginMm;
+            run.fabrication.fitMarginMm = before + 0.5 * e.overshootMm + 1.0;
+            context.info(
+                formatNumbers("a piece came out %.1f mm larger than the printer in every orientation; "
+                              "partitioning again with a fit margin of %.1f mm (was %.1f)",
+                              e.overshootMm, run.fabrication.fitMarginMm, before));
+        }
+    }
+}
+
 /// Stage 7: what the user reads (paper §7): the assembly guide and the cost report (Table 1).
 void reportRun(report::RunRecord& run, const RunOptions& options, RunContext& context) {
     report::RunReports reports = timedStage("report", run, context, [&] {
@@ -143,8 +170,7 @@ report::RunRecord runPipeline(const TriMesh& input, const std::string& sourceNam
     });
     levelSets(run, options, context);
     buildFrame(run, options, context);
-    partitionSurface(run, options, context);
-    makePieces(run, options, context);
+    partitionAndCut(run, options, context);
     reportRun(run, options, context);
     run.totalSeconds = total.seconds();
     return run;

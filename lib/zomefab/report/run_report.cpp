@@ -99,7 +99,11 @@ json costJson(const RunRecord& run) {
     // Per piece, per infill case: what the maker plans prints with.
     json perPiece = json::array();
     for (size_t i = 0; i < run.pieces.pieces.size(); ++i) {
-        json row{{"piece", pieces::pieceName(run.pieces, i)}};
+        const pieces::Piece& piece = run.pieces.pieces[i];
+        json row{{"piece", pieces::pieceName(run.pieces, i)},
+                 {"support_area_mm2", piece.supportAreaMm2},
+                 {"support_volume_mm3", piece.supportVolumeMm3},
+                 {"brim_advised", piece.isBrimAdvised}};
         for (const CostCase& c : run.cost.cases)
             if (i < c.pieces.size())
                 row[c.name] = {{"hours", c.pieces[i].print.hours()},
@@ -205,13 +209,20 @@ std::string perPieceMarkdown(const RunRecord& run) {
         rule += "---:|---:|";
     }
     std::string md =
-        "\n## Per piece\n\nEach piece's print on its own (no supports counted).\n\n| piece | plate |" +
-        columns + "\n|---|---:|" + rule + "\n";
+        "\n## Per piece\n\nEach piece's print on its own (no supports counted). Support: the area facing "
+        "down "
+        "more than 45° from the vertical as oriented, and the volume of support columns under it from the "
+        "bed "
+        "(solid, from the first surface below or the bed; a slicer's sparse support uses a fraction of it).\n\n| piece | plate |" +
+        columns + " support cm² | support cm³ | brim |\n|---|---:|" + rule + "---:|---:|---|\n";
     for (size_t i = 0; i < run.pieces.pieces.size(); ++i) {
         md += "| " + pieces::pieceName(run.pieces, i) + " | " + std::to_string(plate[i]) + " |";
         for (const CostCase& c : run.cost.cases)
             md += formatNumbers(" %.1f | %.0f |", c.pieces[i].print.hours(), c.pieces[i].filament.massG);
-        md += "\n";
+        const pieces::Piece& piece = run.pieces.pieces[i];
+        md +=
+            formatNumbers(" %.0f | %.0f | ", piece.supportAreaMm2 / 100.0, piece.supportVolumeMm3 / 1000.0) +
+            (piece.isBrimAdvised ? "yes" : "no") + " |\n";
     }
     md += "\n## Per plate (print job)\n\n" + std::to_string(run.plates.size()) +
           " print jobs, one per file in plates/.\n\n| plate | pieces |" + columns + "\n|---|---|" + rule +
@@ -288,13 +299,13 @@ RunSummary runSummaryFromJson(const json& report) {
         throw Error(ErrorCode::InvalidInput,
                     std::string("not a run report (format is not \"") + kReportFormatName + "\")");
     RunSummary s;
-    s.peakRssBytes = report.value("peak_rss_bytes", size_t(0));
+    s.peakRssBytes = countFromJson(report, "peak_rss_bytes", 0);
     const json frame = report.value("frame", json::object());
-    s.balls = frame.value("balls", size_t(0));
-    s.struts = frame.value("struts", size_t(0));
+    s.balls = countFromJson(frame, "balls", 0);
+    s.struts = countFromJson(frame, "struts", 0);
     // The printed pieces, after the pieces stage's re-cuts (the partition's regions can be fewer).
     const json pieces = report.value("pieces", json::object());
-    s.pieces = pieces.is_object() ? pieces.value("count", size_t(0)) : 0;
+    s.pieces = pieces.is_object() ? countFromJson(pieces, "count", 0) : 0;
     const json cost = report.value("cost", json::object());
     if (cost.contains("material_saved_hollow_percent") && cost["material_saved_hollow_percent"].is_number()) {
         s.hasMaterialSaved = true;

@@ -266,8 +266,9 @@ Structure structureFromJsonText(const std::string& text, const ZomeScale& physic
     json j;
     try {
         j = json::parse(text);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {
         // nlohmann's message: "[json.exception.parse_error.101] parse error at line 1, column 5: ..."
+        // (also out_of_range.406 for a number beyond double, found by fuzz_frame)
         std::string what = e.what();
         const size_t pos = what.find("] ");
         fail("invalid JSON: " + (pos == std::string::npos ? what : what.substr(pos + 2)));

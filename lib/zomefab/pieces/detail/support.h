@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file What orientation.cpp scores a direction with: the piece mesh in double precision and the
+/// support it would need (support.cpp). docs/pieces.md, "Orientation".
+#pragma once
+
+#include <array>
+#include <initializer_list>
+#include <vector>
+
+#include "zomefab/core/tri_mesh.h"
+#include "zomefab/core/vec.h"
+#include "zomefab/pieces/orientation.h"
+
+namespace zomefab::pieces::detail {
+
+inline constexpr double kPi = 3.14159265358979323846;
+
+/// The mesh in double precision, with each triangle's vector area (area × unit outward normal).
+struct MeshD {
+    std::vector<Vec3d> points;
+    std::vector<Triangle> triangles;
+    std::vector<Vec3d> vectorArea;
+    explicit MeshD(const TriMesh& m) : triangles(m.triangles) {
+        points.reserve(m.positions.size());
+        for (const Vec3f& p : m.positions) points.push_back(toD(p));
+        vectorArea.reserve(triangles.size());
+        for (const Triangle& t : triangles) {
+            const Vec3d& a = points[t[0]];
+            vectorArea.push_back(scale(cross(sub(points[t[1]], a), sub(points[t[2]], a)), 0.5));
+        }
+    }
+};
+
+/// Rows of a rotation taking @p down (unit) to (0, 0, −1): x, y in the bed's plane, z up.
+std::array<Vec3d, 3> rotationDown(const Vec3d& down);
+
+/// The smallest coordinate of the mesh's points along @p up, mm.
+double lowestAlong(const MeshD& m, const Vec3d& up);
+
+/// estimateSupport's area, and the cheap volume: columns down to the bed (no piece below counted).
+SupportEstimate supportOf(const MeshD& m, const Vec3d& down);
+
+/// estimateSupport's volume: columns down to the first up-facing surface below, or the bed.
+double supportColumnsMm3(const MeshD& m, const Vec3d& down);
+
+/// Hill-climbs @p objective down from @p down by tilts of @p stepsDeg (each up to @p iterations
+/// times) about two perpendicular axes, keeping to directions where @p allowed; @p value is
+/// objective(@p down) on entry and at the result on return.
+template <class Objective, class Allowed>
+Vec3d tiltTowardsLess(Vec3d down, double& value, Objective&& objective, Allowed&& allowed,
+                      std::initializer_list<double> stepsDeg = {4.0, 2.0, 1.0}, int iterations = 8) {
+    for (const double stepDeg : stepsDeg) {
+        const double step = std::tan(stepDeg * kPi / 180.0);
+        for (int iteration = 0; iteration < iterations; ++iteration) {
+            const std::array<Vec3d, 3> rows = rotationDown(down);
+            std::vector<std::pair<double, Vec3d>> smaller;  // the tilts that need less support
+            for (const Vec3d& side : {rows[0], scale(rows[0], -1.0), rows[1], scale(rows[1], -1.0)}) {
+                const Vec3d d = normalized(madd(down, step, side));
+                const double v = objective(d);
+                if (v < value - 1e-9 * std::abs(value) - 1e-9) smaller.push_back({v, d});
+            }
+            std::stable_sort(smaller.begin(), smaller.end(),
+                             [](const auto& x, const auto& y) { return x.first < y.first; });
+            bool isMoved = false;
+            for (const auto& [v, d] : smaller)
+                if (allowed(d)) {
+                    down = d, value = v, isMoved = true;
+                    break;
+                }
+            if (!isMoved) break;
+        }
+    }
+    return down;
+}
+
+}  // namespace zomefab::pieces::detail

@@ -1,0 +1,123 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The support a piece would need in an orientation (orientation.h, estimateSupport).
+#include "zomefab/pieces/detail/support.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace zomefab::pieces {
+
+using namespace detail;
+namespace detail {
+
+/// Rows of a rotation taking @p down (unit) to (0, 0, −1).
+std::array<Vec3d, 3> rotationDown(const Vec3d& down) {
+    const Vec3d z = scale(down, -1.0);
+    // A deterministic perpendicular: cross with the axis least aligned with z.
+    int least = 0;
+    for (int k = 1; k < 3; ++k)
+        if (std::abs(z[size_t(k)]) < std::abs(z[size_t(least)])) least = k;
+    Vec3d helper{0, 0, 0};
+    helper[size_t(least)] = 1.0;
+    const Vec3d x = normalized(cross(helper, z));
+    const Vec3d y = cross(z, x);
+    return {x, y, z};
+}
+
+/// The smallest coordinate of the mesh's points along @p up, mm.
+double lowestAlong(const MeshD& m, const Vec3d& up) {
+    double lowest = 1e300;
+    for (const Vec3d& p : m.points) lowest = std::min(lowest, dot(up, p));
+    return lowest;
+}
+
+/// estimateSupport on the double-precision mesh.
+SupportEstimate supportOf(const MeshD& m, const Vec3d& down) {
+    static const double threshold = std::sin(kOverhangDeg * kPi / 180.0);
+    const Vec3d up = scale(down, -1.0);
+    const double lowest = lowestAlong(m, up);
+    SupportEstimate out;
+    for (size_t i = 0; i < m.triangles.size(); ++i) {
+        const double area = norm(m.vectorArea[i]);
+        const double projected = dot(m.vectorArea[i], down);  // area × cos(normal, down)
+        if (!(area > 0) || projected <= threshold * area) continue;
+        const Triangle& t = m.triangles[i];
+        const double h =
+            (dot(up, m.points[t[0]]) + dot(up, m.points[t[1]]) + dot(up, m.points[t[2]])) / 3.0 - lowest;
+        if (h <= kBaseHeightMm) continue;  // on the bed: the first layer, not an overhang
+        out.areaMm2 += area;
+        out.volumeMm3 += projected * h;
+    }
+    return out;
+}
+
+/// Cell of the height map supportColumnsMm3 builds, mm.
+constexpr double kColumnCellMm = 2.0;
+
+/// The volume of support columns under the overhangs (as supportOf) when a column stops at the
+/// first up-facing surface of the piece below it, or the bed: what a slicer that builds supports
+/// on the model too would fill, mm³. For cup-shaped pieces the columns inside the cup end on the
+/// cup's own floor, so this ranks orientations as PrusaSlicer does where supportOf does not. The
+/// mesh is sampled on a kColumnCellMm grid in the bed's plane: each up-facing facet leaves its
+/// height at the cell centres it covers, each overhanging facet adds, per cell centre it covers,
+/// the gap to the highest of those below it.
+double supportColumnsMm3(const MeshD& m, const Vec3d& down) {
+    static const double threshold = std::sin(kOverhangDeg * kPi / 180.0);
+    const std::array<Vec3d, 3> rows = rotationDown(down);  // rows[2] = up
+    std::vector<Vec3d> q(m.points.size());
+    double x0 = 1e300, y0 = 1e300, z0 = 1e300;
+    for (size_t i = 0; i < q.size(); ++i) {
+        q[i] = {dot(rows[0], m.points[i]), dot(rows[1], m.points[i]), dot(rows[2], m.points[i])};
+        x0 = std::min(x0, q[i][0]), y0 = std::min(y0, q[i][1]), z0 = std::min(z0, q[i][2]);
+    }
+    // Visits the cell centres inside the triangle's projection with the triangle's height there.
+    auto forCells = [&](const Triangle& t, auto&& visit) {
+        const Vec3d &a = q[t[0]], &b = q[t[1]], &c = q[t[2]];
+        const double det = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+        if (std::abs(det) < 1e-12) return;
+        const int i0 = int(std::ceil((std::min({a[0], b[0], c[0]}) - x0) / kColumnCellMm - 0.5));
+        const int i1 = int(std::floor((std::max({a[0], b[0], c[0]}) - x0) / kColumnCellMm - 0.5));
+        const int j0 = int(std::ceil((std::min({a[1], b[1], c[1]}) - y0) / kColumnCellMm - 0.5));
+        const int j1 = int(std::floor((std::max({a[1], b[1], c[1]}) - y0) / kColumnCellMm - 0.5));
+        for (int i = std::max(i0, 0); i <= i1; ++i)
+            for (int j = std::max(j0, 0); j <= j1; ++j) {
+                const double x = x0 + (i + 0.5) * kColumnCellMm, y = y0 + (j + 0.5) * kColumnCellMm;
+                const double u = ((x - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (y - a[1])) / det;
+                const double v = ((b[0] - a[0]) * (y - a[1]) - (x - a[0]) * (b[1] - a[1])) / det;
+                if (u < 0 || v < 0 || u + v > 1) continue;
+                visit(uint64_t(i) << 32 | uint64_t(j), a[2] + u * (b[2] - a[2]) + v * (c[2] - a[2]));
+            }
+    };
+    std::vector<std::pair<uint64_t, double>> floors;  // (cell, height) of up-facing surfaces
+    for (size_t k = 0; k < m.triangles.size(); ++k)
+        if (dot(m.vectorArea[k], rows[2]) > 0)
+            forCells(m.triangles[k], [&](uint64_t cell, double z) { floors.push_back({cell, z}); });
+    std::sort(floors.begin(), floors.end());
+    double volume = 0.0;
+    for (size_t k = 0; k < m.triangles.size(); ++k) {
+        const double area = norm(m.vectorArea[k]);
+        if (!(area > 0) || dot(m.vectorArea[k], down) <= threshold * area) continue;
+        forCells(m.triangles[k], [&](uint64_t cell, double z) {
+            if (z - z0 <= kBaseHeightMm) return;
+            // The highest floor in this cell below the overhang (half a cell of slack for the
+            // facets of the same wall).
+            auto it =
+                std::lower_bound(floors.begin(), floors.end(), std::make_pair(cell, z - 0.5 * kColumnCellMm));
+            double floor = z0;
+            if (it != floors.begin() && std::prev(it)->first == cell) floor = std::prev(it)->second;
+            volume += (z - floor) * kColumnCellMm * kColumnCellMm;
+        });
+    }
+    return volume;
+}
+
+}  // namespace detail
+
+SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down) {
+    const MeshD mesh(meshMm);
+    const Vec3d d = normalized(down);
+    return {supportOf(mesh, d).areaMm2, supportColumnsMm3(mesh, d)};
+}
+
+}  // namespace zomefab::pieces
