@@ -142,7 +142,8 @@ PartitionFile parsePartitionFile(std::string_view bytes, const std::string& sour
     } catch (const Error& e) {
         throw e.withFile(sourceName);
     } catch (const json::exception& e) {
-        throw Error(ErrorCode::InvalidInput, std::string("malformed partition file: ") + e.what(), sourceName);
+        throw Error(ErrorCode::InvalidInput, std::string("malformed partition file: ") + e.what(),
+                    sourceName);
     }
 }
 

@@ -412,8 +412,9 @@ bool verifyChecksum(Cursor& c, const Header& header, const MetaMapRead& fileMeta
         c.fail(entry->entryStart, "the checksum entry is damaged");
     const std::string_view stored = bytes.substr(entry->valueStart, 8);
     if (stored != hex8(checksumWithPlaceholder(bytes, entry->valueStart, 8)))
-        c.error("damaged .vdb stream: its checksum does not match its contents (the file changed after zomefab "
-                "wrote it)");
+        c.error(
+            "damaged .vdb stream: its checksum does not match its contents (the file changed after zomefab "
+            "wrote it)");
     return true;
 }
 

@@ -23,11 +23,11 @@ inline constexpr const char* kVdbUuidMark = "7a6f6d65-";
 
 /// What checkVdbStream found.
 struct VdbCheck {
-    std::string sanitized;        ///< the bytes for OpenVDB: per-grid "file_delayed_load" entries removed
+    std::string sanitized;          ///< the bytes for OpenVDB: per-grid "file_delayed_load" entries removed
     bool writtenByZomefab = false;  ///< checksum present and correct
     int gridCount = 0;
-    uint64_t leafCount = 0;       ///< leaf nodes of all trees
-    uint64_t treeBytes = 0;       ///< estimated memory of the trees once parsed
+    uint64_t leafCount = 0;  ///< leaf nodes of all trees
+    uint64_t treeBytes = 0;  ///< estimated memory of the trees once parsed
 };
 
 /// Checks @p bytes as a .vdb stream (file format 222-224, the one OpenVDB 10 writes). Float trees
