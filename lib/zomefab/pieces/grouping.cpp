@@ -16,23 +16,30 @@ namespace {
 
 using Contacts = std::map<std::pair<uint32_t, uint32_t>, size_t>;
 
+/// A piece of at most this many voxels' volume that touches no other is a speck (Merger::mergeSpeck).
+constexpr double kSpeckVoxels = 2.0;
+
 /// Components of one group that touch form one piece. Then two kinds of pieces join the
 /// neighbour they share the largest cut face with: the parts of the shell in cells that no
 /// request names (cells with no outer surface: the partition meant no piece there), whatever
 /// their size, and slivers below minPieceVolumeMm3. Never dropped: with no neighbour they stay.
 struct Merger {
+    const std::vector<Component>& comps;
     const Contacts& contacts;
     DisjointSets sets;
     std::vector<double> rootVolume;
     std::vector<uint32_t> rootSlivers;
     std::vector<uint8_t> isOrphan;  ///< per root: only components of unnamed cells
+    double voxelVolume;
 
     Merger(const std::vector<Component>& comps, const Contacts& c, size_t requestCount, double voxelVolume)
-        : contacts(c),
+        : comps(comps),
+          contacts(c),
           sets(comps.size()),
           rootVolume(comps.size(), 0.0),
           rootSlivers(comps.size(), 0),
-          isOrphan(comps.size(), 0) {
+          isOrphan(comps.size(), 0),
+          voxelVolume(voxelVolume) {
         for (const auto& [pair, count] : contacts)
             if (comps[pair.first].group == comps[pair.second].group) sets.unite(pair.first, pair.second);
         for (size_t k = 0; k < comps.size(); ++k) {
@@ -84,6 +91,32 @@ struct Merger {
         return roots;
     }
 
+    /// A speck of @p root (a few voxels touching no other piece: a corner of a cell the cut grazed)
+    /// joins the largest piece that has a component in one of its cells; the mesher drops it there
+    /// (components under a voxel's volume), where kept as a piece of its own it would be an empty
+    /// mesh (seen: bunny at 600 mm, "piece 21: ... volume 0 mm³"). False when no piece shares a cell.
+    bool mergeSpeck(uint32_t root) {
+        std::vector<uint32_t> cellsOfRoot;
+        for (size_t k = 0; k < comps.size(); ++k)
+            if (sets.find(uint32_t(k)) == root) cellsOfRoot.push_back(comps[k].cell);
+        uint32_t target = kNone;
+        for (size_t k = 0; k < comps.size(); ++k) {
+            const uint32_t r = sets.find(uint32_t(k));
+            if (r == root ||
+                std::find(cellsOfRoot.begin(), cellsOfRoot.end(), comps[k].cell) == cellsOfRoot.end())
+                continue;
+            if (target == kNone || rootVolume[r] > rootVolume[target]) target = r;
+        }
+        if (target == kNone) return false;
+        const double volume = rootVolume[root] + rootVolume[target];
+        const uint32_t slivers = rootSlivers[target];
+        const bool isStillOrphan = isOrphan[target];
+        sets.unite(root, target);
+        const uint32_t merged = sets.find(root);
+        rootVolume[merged] = volume, rootSlivers[merged] = slivers, isOrphan[merged] = isStillOrphan;
+        return true;
+    }
+
     /// Orphans first (until none can move), then slivers. Returns the orphans kept.
     size_t mergeAll(double minPieceVolumeMm3, Grouping& out, const RunContext& context) {
         size_t orphansKept = 0;
@@ -110,6 +143,12 @@ struct Merger {
             if (rootVolume[root] >= minPieceVolumeMm3) continue;
             if (mergeIntoNeighbour(root, false)) {
                 ++out.sliversMerged;
+            } else if (rootVolume[root] <= kSpeckVoxels * voxelVolume && mergeSpeck(root)) {
+                ++out.specksMerged;
+                context.detail(
+                    "a " + formatNumber(rootVolume[root], 4) +
+                    " mm³ speck of the shell touches no other piece: it joins the largest piece of its cell, "
+                    "where the mesher drops it");
             } else {
                 ++out.isolatedSlivers;
                 context.warn("a " + formatNumber(rootVolume[root], 4) +
