@@ -89,7 +89,7 @@ void checkClosedAndFits(const Pieces& result) {
         // Every piece, cut face down or not, stands on a base the first layer can print (a piece
         // on a point or an edge is what PrusaSlicer refuses: "no extrusions in the first layer").
         const double baseMm2 = baseAreaMm2(p.mesh, {0, 0, -1});
-        CHECK(baseMm2 > 50.0);
+        CHECK(baseMm2 >= 25.0);  // kMinBaseMm2
         CHECK(p.baseAreaMm2 == doctest::Approx(baseMm2).epsilon(1e-6));
     }
 }
@@ -105,7 +105,7 @@ TEST_CASE("pieces: the union of the pieces is the shell (volume and sampled poin
     double total = 0;
     for (const Piece& p : result.pieces) {
         total += p.volumeMm3;
-        CHECK(p.baseAreaMm2 >= 50.0);  // orientForPrinter's smallest first layer
+        CHECK(p.baseAreaMm2 >= 25.0);  // orientForPrinter's smallest first layer
         CHECK(p.isBrimAdvised == (p.baseAreaMm2 < kBrimBelowMm2));
         CHECK(p.cells.size() == 1);
         CHECK(p.requests == p.cells);

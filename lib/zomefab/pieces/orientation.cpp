@@ -218,11 +218,11 @@ Vec3d tiltTowardsLargerBase(const MeshD& m, Vec3d down, double& contact, Fits&& 
     return down;
 }
 
-/// The smallest first layer a resting orientation may have (a 7 × 7 mm patch): below it slicers
+/// The smallest first layer a resting orientation may have (a 5 × 5 mm patch): below it slicers
 /// find little to extrude in the first layer, and the piece's hold on the bed is its supports'.
-constexpr double kMinBaseMm2 = 50.0;
+constexpr double kMinBaseMm2 = 25.0;
 /// What a first layer below kBrimBelowMm2 costs in the orientation score, per mm² missing, in mm³
-/// of support columns: a 50 mm² base costs 88 cm³ of columns (about 20 cm³ of sparse support), so
+/// of support columns: a 25 mm² base costs 94 cm³ of columns (about 20 cm³ of sparse support), so
 /// a piece rests on little only where that saves much more support.
 constexpr double kContactPenaltyMm3PerMm2 = 250.0;
 

@@ -81,7 +81,7 @@ struct PrintOrientation {
 /// candidates: the cut faces of at least kMinCutFaceAreaMm2 that no vertex lies beyond by more
 /// than @p flatToleranceMm (a flat base), and directions the piece rests on (the normals of the
 /// cut faces and of the mesh's largest facets, 256 sphere directions) with a first layer of at
-/// least 50 mm². Of those that fit, the one with the least support wins:
+/// least 25 mm². Of those that fit, the one with the least support wins:
 /// each is scored by estimateSupport's volume (columns down to the piece below or the bed) plus a
 /// penalty for a first layer under kBrimBelowMm2; the best 8 resting directions are tilted in
 /// small steps towards less support. A cut face wins unless a resting direction scores clearly
