@@ -298,6 +298,50 @@ TEST_CASE("long: every plate slices on the printer's bed as it is and stays insi
         CHECK(placed[pieces::pieceName(d.result.pieces, i)] == 1);
 }
 
+TEST_CASE(
+    "long: automatic supports on the demo's plates need at most half of what the cut-face orientation did") {
+    if (!report::isSlicerAvailable()) {
+        MESSAGE("prusa-slicer is not installed: skipped");
+        return;
+    }
+    // Issue 15's measure (docs/benchmarks.md, "Supports today"): every plate sliced with and without
+    // PrusaSlicer's automatic supports; the print orientation of before (a cut face down) needed
+    // 1,915 cm³ of support filament on this demo.
+    constexpr double kBeforeMm3 = 1915e3;
+    const DemoRun& d = demo();
+    const Vec3d bed = d.options.fabrication.printerMm;
+    double supportMm3 = 0;
+    for (const json& plate : d.report["plates"]) {
+        const std::string file = d.file(plate["file"].get<std::string>());
+        double filament[2] = {0, 0};
+        for (int withSupports = 0; withSupports < 2; ++withSupports) {
+            test::ScratchDir dir("zomefab-support");
+            const std::string gcode = dir.file("plate.gcode");
+            const std::string command =
+                formatNumbers(
+                    "prusa-slicer --loglevel 1 --export-gcode --dont-arrange --layer-height 0.3 "
+                    "--first-layer-height 0.3 --nozzle-diameter 0.4 --filament-diameter 2.85 --fill-density "
+                    "20%% "
+                    "--perimeters 3 --gcode-flavor marlin2 --bed-shape 0x0,%gx0,%gx%g,0x%g "
+                    "--max-print-height %g",
+                    bed[0], bed[0], bed[1], bed[1], bed[2]) +
+                (withSupports ? " --support-material --support-material-auto" : "");
+            std::string log;
+            INFO(file);
+            REQUIRE(test::runCapture(command + " -o " + gcode + " " + file + " 2>&1", &log) == 0);
+            const std::string text = readInputBytes(gcode);
+            const size_t at = text.find("; filament used [cm3] = ");
+            REQUIRE(at != std::string::npos);
+            filament[withSupports] = 1000.0 * std::stod(text.substr(at + 24));
+        }
+        MESSAGE(plate["file"].get<std::string>()
+                << ": support " << (filament[1] - filament[0]) / 1000 << " cm³");
+        supportMm3 += filament[1] - filament[0];
+    }
+    MESSAGE("support filament on all plates: " << supportMm3 / 1000 << " cm³ (before: 1,915 cm³)");
+    CHECK(supportMm3 <= 0.5 * kBeforeMm3);
+}
+
 TEST_CASE("long: the estimator agrees with PrusaSlicer within 15 % on the pieces and the baseline") {
     if (!report::isSlicerAvailable()) {
         MESSAGE(
