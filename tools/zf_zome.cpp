@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
             const std::vector<zome::Collision> collisions = zome::findCollisions(frame);
             const zome::PartsList list = zome::partsList(frame);
             const nlohmann::json out = zome::checkReportJson(frame, input, collisions, prices);
-            tool.writeOutput(output, [&](std::ostream& o) { o << out.dump(2) << '\n'; });
+            tool.writeJsonOutput(output, out);
             report["collisions"] = collisions.size();
             report["seconds"] = clock.seconds();
             if (!collisions.empty()) {

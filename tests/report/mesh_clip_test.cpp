@@ -22,7 +22,7 @@ TEST_CASE("mesh_clip: a box cut across keeps the exact part, closed and outward"
     CHECK(isClosedOriented(above));
     CHECK(signedVolume(below) == doctest::Approx(3.0 * 600.0).epsilon(1e-6));
     CHECK(signedVolume(above) == doctest::Approx(7.0 * 600.0).epsilon(1e-6));
-    CHECK(meshAreaMm2(below) == doctest::Approx(2 * (3 * 20 + 3 * 30 + 20 * 30)).epsilon(1e-6));
+    CHECK(surfaceArea(below) == doctest::Approx(2 * (3 * 20 + 3 * 30 + 20 * 30)).epsilon(1e-6));
     const Box3d b = boundingBox(below);
     CHECK(b.max[0] == doctest::Approx(3.0));
     CHECK(b.min[0] == 0.0);
@@ -85,7 +85,7 @@ TEST_CASE("mesh_clip: clipToBox of a sphere around a cube gives the cube") {
     const TriMesh cube = clipToBox(sphere, box);
     CHECK(isClosedOriented(cube));
     CHECK(signedVolume(cube) == doctest::Approx(1000.0).epsilon(1e-5));
-    CHECK(meshAreaMm2(cube) == doctest::Approx(600.0).epsilon(1e-5));
+    CHECK(surfaceArea(cube) == doctest::Approx(600.0).epsilon(1e-5));
 }
 
 TEST_CASE("mesh_clip: the shell piece fixture is closed and has the octant's volume") {

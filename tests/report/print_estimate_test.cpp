@@ -115,7 +115,7 @@ TEST_CASE("print_estimate: parts are turned onto their largest flat face") {
     for (const Triangle& t : turned.triangles)
         if (turned.positions[t[0]][2] == 0.0f && turned.positions[t[1]][2] == 0.0f &&
             turned.positions[t[2]][2] == 0.0f)
-            bedArea += meshAreaMm2(TriMesh{
+            bedArea += surfaceArea(TriMesh{
                 {turned.positions[t[0]], turned.positions[t[1]], turned.positions[t[2]]}, {{0, 1, 2}}, {}});
     CHECK(bedArea == doctest::Approx(std::acos(-1.0) * 900.0).epsilon(0.01));  // the cap, r = 30 mm
     // The upper half already has its cap down: only moved to z = 0.

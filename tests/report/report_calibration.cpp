@@ -147,7 +147,7 @@ int main(int argc, char** argv) {
                           &mesh,
                           estimatePrint(mesh, s, unit),
                           sliceWithPrusaSlicer(mesh, s, name),
-                          meshAreaMm2(mesh)};
+                          surfaceArea(mesh)};
             std::fprintf(stderr,
                          "%s %.0f%%: slicer %.0f s %.0f mm3, shell %.0f mm3 infill %.0f mm3 layers %zu\n",
                          name.c_str(), infill, sample.slicer.seconds, sample.slicer.filamentMm3,

@@ -29,11 +29,12 @@ std::vector<std::pair<std::string, std::string>> damagedVariants(const std::stri
     std::string uuid = good;
     uuid[30] = char(uuid[30] ^ 0x01);
     out.emplace_back("one bit of the header", uuid);
-    const size_t gridName = 57 + 4 + 39 + 4;  // header, file metadata (checksum entry), grid count
+    const size_t gridName = test::kVdbGridNameAt + test::kVdbChecksumEntryBytes;  // with the checksum entry
     out.emplace_back("huge grid-name length", test::withU32(good, gridName, 0xfffffff0u));
     out.emplace_back("truncated header", good.substr(0, 40));
     const std::string foreign = test::withoutVdbChecksum(good);
-    out.emplace_back("huge grid-name length, no checksum", test::withU32(foreign, 57 + 4 + 4, 0xfffffff0u));
+    out.emplace_back("huge grid-name length, no checksum",
+                     test::withU32(foreign, test::kVdbGridNameAt, 0xfffffff0u));
     const size_t metaSize = foreign.find("class") + 5 + 4 + 6;
     out.emplace_back("huge metadata length, no checksum", test::withU32(foreign, metaSize, 0x7ffffff0u));
     out.emplace_back("truncated in the tree, no checksum", foreign.substr(0, foreign.size() / 2));

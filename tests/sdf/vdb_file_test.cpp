@@ -145,7 +145,7 @@ std::string parseError(const std::string& bytes) {
 
 TEST_CASE("vdb_file: a zomefab file carries its checksum, and any flipped bit is a one-line InvalidInput") {
     const std::string good = smallZomefabVdb();
-    CHECK(good.compare(21, 9, "7a6f6d65-") == 0);  // the UUID mark
+    CHECK(good.compare(test::kVdbUuidAt, 9, "7a6f6d65-") == 0);  // the UUID mark
     CHECK(parseError(good).empty());
     // Every byte, one bit each (the bit changes with the position): header, metadata, topology,
     // compressed values.
@@ -174,15 +174,16 @@ TEST_CASE("vdb_file: lengths and counts are checked before OpenVDB trusts them")
     const std::string foreign = test::withoutVdbChecksum(smallZomefabVdb());
     RunContext context;
     REQUIRE(parseVdb(foreign, "in.vdb", context).size() == 1);  // still readable without the checksum
-    const size_t gridName = 57 + 4 + 4;                         // file metadata count, grid count
+    const size_t gridName = test::kVdbGridNameAt;               // file metadata count, grid count
     CHECK(parseError(test::withU32(foreign, gridName, 0xfffffff0u))
               .find("a grid name announces 4294967280 bytes") != std::string::npos);
     const size_t gridMetaSize = foreign.find("class") + 5 + 4 + 6;  // the first entry's size field
     CHECK(parseError(test::withU32(foreign, gridMetaSize, 0x7fffffffu))
               .find("truncated .vdb stream: a metadata value") != std::string::npos);
-    CHECK(parseError(test::withU32(foreign, 57, 0x40000000u)).find("the file metadata announces") !=
+    CHECK(parseError(test::withU32(foreign, test::kVdbFileMetaAt, 0x40000000u))
+              .find("the file metadata announces") != std::string::npos);
+    CHECK(parseError(test::withU32(foreign, test::kVdbFileMetaAt + 4, 0x7fffffffu)).find("grid count") !=
           std::string::npos);
-    CHECK(parseError(test::withU32(foreign, 57 + 4, 0x7fffffffu)).find("grid count") != std::string::npos);
     CHECK(parseError(foreign.substr(0, 40)).find("truncated .vdb stream: the archive UUID") !=
           std::string::npos);
     CHECK(parseError(foreign.substr(0, 6)).find("not a .vdb file") != std::string::npos);

@@ -10,19 +10,26 @@
 
 namespace zomefab::test {
 
+// Where things are in a stream zomefab wrote (vdb_check.cpp has the layout).
+inline constexpr size_t kVdbUuidAt = 21;      ///< header: magic 8, versions 12, offsets flag 1
+inline constexpr size_t kVdbFileMetaAt = 57;  ///< after the 36-character UUID: the file metadata count
+/// The checksum entry: name "zomefab_crc32" (4 + 13), type "string" (4 + 6), size (4), 8 hex digits.
+inline constexpr size_t kVdbChecksumEntryBytes = 4 + 13 + 4 + 6 + 4 + 8;
+/// The first grid's name length in a file without the checksum entry: after the file metadata
+/// count (4) and the grid count (4).
+inline constexpr size_t kVdbGridNameAt = kVdbFileMetaAt + 4 + 4;
+
 /// The same grids without zomefab's checksum: the file metadata entry dropped and the UUID mark
 /// broken, which is what a file from another program looks like to the reader.
 inline std::string withoutVdbChecksum(std::string bytes) {
-    const size_t uuid = 21, meta = 57;  // header: magic 8, versions 12, offsets flag 1; UUID 36
-    bytes[uuid] = 'f';
+    bytes[kVdbUuidAt] = 'f';
     uint32_t count;
-    std::memcpy(&count, &bytes[meta], 4);
+    std::memcpy(&count, &bytes[kVdbFileMetaAt], 4);
     REQUIRE(count == 1);
-    REQUIRE(bytes.compare(meta + 8, 13, "zomefab_crc32") == 0);
-    const size_t entry = 4 + 13 + 4 + 6 + 4 + 8;  // name, type "string", size, 8 hex digits
+    REQUIRE(bytes.compare(kVdbFileMetaAt + 8, 13, "zomefab_crc32") == 0);
     count = 0;
-    std::memcpy(&bytes[meta], &count, 4);
-    bytes.erase(meta + 4, entry);
+    std::memcpy(&bytes[kVdbFileMetaAt], &count, 4);
+    bytes.erase(kVdbFileMetaAt + 4, kVdbChecksumEntryBytes);
     return bytes;
 }
 

@@ -138,7 +138,7 @@ int Tool::run(int argc, char** argv, const std::function<int(nlohmann::json&)>& 
             report["tool"] = mName;
             report["generator"] = generatorString();
             report["warnings"] = mContext->warnings();
-            mOutputs.add(mCommon.reportPath, [&](std::ostream& out) { out << report.dump(2) << '\n'; });
+            writeJsonOutput(mCommon.reportPath, report);
         }
         mOutputs.commit();
         return code;
@@ -158,8 +158,19 @@ void printInfo(const Tool& tool, const std::string& message) {
     if (tool.common().verbosity >= 0) std::cerr << tool.name() << ": " << message << '\n';
 }
 
+namespace {
+
+/// The tools' JSON files: 2-space indent, a final newline.
+void writeJsonText(std::ostream& out, const nlohmann::json& json) { out << json.dump(2) << '\n'; }
+
+}  // namespace
+
+void Tool::writeJsonOutput(const std::string& path, const nlohmann::json& json) {
+    mOutputs.add(path, [&](std::ostream& out) { writeJsonText(out, json); });
+}
+
 void writeJsonFile(const nlohmann::json& json, const std::string& path) {
-    writeOutputAtomic(path, [&](std::ostream& out) { out << json.dump(2) << '\n'; });
+    writeOutputAtomic(path, [&](std::ostream& out) { writeJsonText(out, json); });
 }
 
 }  // namespace zomefab::cli

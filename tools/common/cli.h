@@ -42,6 +42,8 @@ public:
     void writeOutput(const std::string& path, const std::function<void(std::ostream&)>& write) {
         mOutputs.add(path, write);
     }
+    /// writeOutput of @p json as writeJsonFile formats it.
+    void writeJsonOutput(const std::string& path, const nlohmann::json& json);
 
     /// Adds `--in-format` / `--out-format`-style option that only accepts @p choices.
     CLI::Option* addFormatOption(const std::string& flag, std::string& target,

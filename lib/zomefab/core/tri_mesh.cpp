@@ -87,6 +87,15 @@ double signedVolume(const TriMesh& mesh, const Vec3d& origin) {
     return sum / 6.0;
 }
 
+double surfaceArea(const TriMesh& mesh) {
+    double sum = 0;
+    for (const Triangle& tri : mesh.triangles) {
+        const Vec3d a = toD(mesh.positions[tri[0]]);
+        sum += 0.5 * norm(cross(sub(toD(mesh.positions[tri[1]]), a), sub(toD(mesh.positions[tri[2]]), a)));
+    }
+    return sum;
+}
+
 VertexComponents vertexComponents(const TriMesh& mesh) {
     const size_t nv = mesh.positions.size();
     DisjointSets sets(nv);

@@ -56,6 +56,8 @@ void weldIdenticalVertices(TriMesh& mesh);
 double signedVolume(const TriMesh& mesh, const std::vector<uint32_t>& triangles, const Vec3d& origin);
 /// The same over every triangle.
 double signedVolume(const TriMesh& mesh, const Vec3d& origin = {0, 0, 0});
+/// Area of all triangles, squared mesh units (mm² after scaling).
+double surfaceArea(const TriMesh& mesh);
 
 /// The vertex-connected components of a mesh (triangles sharing a vertex are connected).
 struct VertexComponents {

@@ -22,7 +22,8 @@ constexpr double kSpeckVoxels = 2.0;
 /// Components of one group that touch form one piece. Then two kinds of pieces join the
 /// neighbour they share the largest cut face with: the parts of the shell in cells that no
 /// request names (cells with no outer surface: the partition meant no piece there), whatever
-/// their size, and slivers below minPieceVolumeMm3. Never dropped: with no neighbour they stay.
+/// their size, and slivers below minPieceVolumeMm3. Never dropped: with no neighbour they stay, but
+/// for specks, which join a piece of their cell (mergeSpeck).
 struct Merger {
     const std::vector<Component>& comps;
     const Contacts& contacts;
@@ -71,15 +72,20 @@ struct Merger {
             const bool isSameKind = isOrphan[target] == isOrphan[r];
             if (isBetterKind || (isSameKind && count > shared[target])) target = r;
         }
+        join(root, target, rootSlivers[root] + rootSlivers[target] + (isOrphanPass ? 0 : 1),
+             isOrphan[root] && isOrphan[target]);
+        return true;
+    }
+
+    /// Unites the roots @p root and @p target; the merged root gets both volumes, @p slivers and
+    /// @p isStillOrphan.
+    void join(uint32_t root, uint32_t target, uint32_t slivers, bool isStillOrphan) {
         const double volume = rootVolume[root] + rootVolume[target];
-        const uint32_t slivers = rootSlivers[root] + rootSlivers[target] + (isOrphanPass ? 0 : 1);
-        const bool isStillOrphan = isOrphan[root] && isOrphan[target];
         sets.unite(root, target);
         const uint32_t merged = sets.find(root);
         rootVolume[merged] = volume;
         rootSlivers[merged] = slivers;
         isOrphan[merged] = isStillOrphan;
-        return true;
     }
 
     std::vector<uint32_t> rootsByVolume() {
@@ -108,12 +114,7 @@ struct Merger {
             if (target == kNone || rootVolume[r] > rootVolume[target]) target = r;
         }
         if (target == kNone) return false;
-        const double volume = rootVolume[root] + rootVolume[target];
-        const uint32_t slivers = rootSlivers[target];
-        const bool isStillOrphan = isOrphan[target];
-        sets.unite(root, target);
-        const uint32_t merged = sets.find(root);
-        rootVolume[merged] = volume, rootSlivers[merged] = slivers, isOrphan[merged] = isStillOrphan;
+        join(root, target, rootSlivers[target], isOrphan[target]);
         return true;
     }
 
@@ -144,7 +145,6 @@ struct Merger {
             if (mergeIntoNeighbour(root, false)) {
                 ++out.sliversMerged;
             } else if (rootVolume[root] <= kSpeckVoxels * voxelVolume && mergeSpeck(root)) {
-                ++out.specksMerged;
                 context.detail(
                     "a " + formatNumber(rootVolume[root], 4) +
                     " mm³ speck of the shell touches no other piece: it joins the largest piece of its cell, "

@@ -173,9 +173,14 @@ const double kSameDirectionCos = std::cos(kPi / 180.0);
 constexpr size_t kFacetDirections = 128;
 /// How many of the best directions are refined by tilting.
 constexpr size_t kRefineStarts = 4;
-/// How many of the directions needing the least support (by the cheap estimate) are refined and
-/// measured by supportColumnsMm3.
+/// How many of the best-scored resting directions are refined by tilting.
 constexpr size_t kSupportStarts = 8;
+
+/// @p d lies within 1° of one of @p directions.
+bool isNearAny(const std::vector<Vec3d>& directions, const Vec3d& d) {
+    return std::any_of(directions.begin(), directions.end(),
+                       [&](const Vec3d& e) { return dot(e, d) > kSameDirectionCos; });
+}
 
 /// The outward normals of the largest facets, at most kFacetDirections, no two within 1°.
 std::vector<Vec3d> facetDirections(const MeshD& m) {
@@ -186,9 +191,7 @@ std::vector<Vec3d> facetDirections(const MeshD& m) {
     for (const auto& [negArea, i] : bySize) {
         if (out.size() == kFacetDirections || negArea == 0.0) break;
         const Vec3d n = normalized(m.vectorArea[i]);
-        if (std::none_of(out.begin(), out.end(),
-                         [&](const Vec3d& d) { return dot(d, n) > kSameDirectionCos; }))
-            out.push_back(n);
+        if (!isNearAny(out, n)) out.push_back(n);
     }
     return out;
 }
@@ -248,14 +251,16 @@ public:
     }
 
     bool fits(const Vec3d& d) const { return evaluate(mesh.points, d, printer).placement.ratio <= 1.0; }
-    bool hasFirstLayer(const Vec3d& d) const { return sectionArea(mesh, d, kBaseHeightMm) >= kMinBaseMm2; }
-    /// Support volume plus what a small first layer costs (kContactPenaltyMm3PerMm2 below a brim's
-    /// worth of base), less a tie-break for the larger base.
-    double score(const Vec3d& d) const {
-        const double base = sectionArea(mesh, d, kBaseHeightMm);
-        return supportColumnsMm3(mesh, d) + kContactPenaltyMm3PerMm2 * std::max(0.0, kBrimBelowMm2 - base) -
-               kBaseTieBreakMm3PerMm2 * base;
+    double firstLayerMm2(const Vec3d& d) const { return sectionArea(mesh, d, kBaseHeightMm); }
+    bool hasFirstLayer(const Vec3d& d) const { return firstLayerMm2(d) >= kMinBaseMm2; }
+    /// Support volume plus what a first layer of @p baseMm2 costs below a brim's worth
+    /// (kContactPenaltyMm3PerMm2), less a tie-break for the larger base.
+    double score(const Vec3d& d, double baseMm2) const {
+        return supportColumnsMm3(mesh, d) +
+               kContactPenaltyMm3PerMm2 * std::max(0.0, kBrimBelowMm2 - baseMm2) -
+               kBaseTieBreakMm3PerMm2 * baseMm2;
     }
+    double score(const Vec3d& d) const { return score(d, firstLayerMm2(d)); }
     /// How far the piece reaches beyond the plane of @p f, mm.
     double beyondMm(const CutFace& f) const {
         double beyond = -1e300;
@@ -287,16 +292,14 @@ public:
     void findResting() {
         std::vector<std::pair<double, size_t>> byScore;  // least first
         for (size_t i = 0; i < directions.size(); ++i)
-            if (hasFirstLayer(directions[i])) byScore.push_back({score(directions[i]), i});
+            if (const double base = firstLayerMm2(directions[i]); base >= kMinBaseMm2)
+                byScore.push_back({score(directions[i], base), i});
         std::sort(byScore.begin(), byScore.end());
         std::vector<Vec3d> starts;
         for (const auto& [score0, i] : byScore) {
             if (starts.size() == kSupportStarts) break;
-            const Vec3d& direction = directions[i];  // (clang cannot capture a structured binding)
-            const bool isNear = std::any_of(starts.begin(), starts.end(), [&](const Vec3d& s) {
-                return dot(s, direction) > kSameDirectionCos;
-            });
-            if (isNear || !fits(direction)) continue;
+            const Vec3d& direction = directions[i];
+            if (isNearAny(starts, direction) || !fits(direction)) continue;
             starts.push_back(direction);
             // Tilted by the cheap estimate (columns down to the bed), kept where the score agrees.
             double support = supportOf(mesh, direction).volumeMm3;
@@ -322,10 +325,7 @@ public:
             if (starts.size() == kRefineStarts) break;
             if (-negContact <= bestContact) break;  // tilting only enlarges: no later start can win
             const Vec3d& direction = directions[i];
-            const bool isNear = std::any_of(starts.begin(), starts.end(), [&](const Vec3d& s) {
-                return dot(s, direction) > kSameDirectionCos;
-            });
-            if (isNear || !fits(direction)) continue;
+            if (isNearAny(starts, direction) || !fits(direction)) continue;
             starts.push_back(direction);
             double contact = -negContact;
             const Vec3d refined =
@@ -456,8 +456,7 @@ PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFa
         if (!out.isCutFaceDown && dot(f.outwardNormal, out.downNormal) > 1.0 - 1e-12 &&
             search.beyondMm(f) <= flatToleranceMm)
             out.isCutFaceDown = true;
-    out.support = {supportOf(search.mesh, out.downNormal).areaMm2,
-                   supportColumnsMm3(search.mesh, out.downNormal)};
+    out.support = estimateSupport(search.mesh, out.downNormal);
     place(search.mesh, printer, out);
     if (!out.isCutFaceDown) out.note = search.note(out);
     return out;

@@ -100,11 +100,10 @@ void readOrientation(const json& o, Piece& piece, const std::string& what) {
     });
     piece.isCutFaceDown = o.value("cut_face_down", false);
     piece.downNormalGridMm = optionalField(o, "down_normal", Vec3d{0, 0, -1}, vec("down_normal"));
-    piece.baseAreaMm2 = optionalField(
-        o, "base_area_mm2", 0.0, [&](const json& v) { return numberFromJson(v, what + ".base_area_mm2"); });
     auto number = [&](const char* key) {
         return [&, key](const json& v) { return numberFromJson(v, what + "." + key); };
     };
+    piece.baseAreaMm2 = optionalField(o, "base_area_mm2", 0.0, number("base_area_mm2"));
     piece.supportAreaMm2 = optionalField(o, "support_area_mm2", 0.0, number("support_area_mm2"));
     piece.supportVolumeMm3 = optionalField(o, "support_volume_mm3", 0.0, number("support_volume_mm3"));
     piece.isBrimAdvised = o.value("brim_advised", false);

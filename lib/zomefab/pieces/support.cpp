@@ -32,22 +32,30 @@ double lowestAlong(const MeshD& m, const Vec3d& up) {
     return lowest;
 }
 
-/// estimateSupport on the double-precision mesh.
-SupportEstimate supportOf(const MeshD& m, const Vec3d& down) {
+namespace {
+
+/// A facet of vector area @p vectorArea faces down (along unit @p down) more steeply than
+/// kOverhangDeg from the vertical: it needs support.
+bool isOverhang(const Vec3d& vectorArea, const Vec3d& down) {
     static const double threshold = std::sin(kOverhangDeg * kPi / 180.0);
+    const double area = norm(vectorArea);
+    return area > 0 && dot(vectorArea, down) > threshold * area;
+}
+
+}  // namespace
+
+SupportEstimate supportOf(const MeshD& m, const Vec3d& down) {
     const Vec3d up = scale(down, -1.0);
     const double lowest = lowestAlong(m, up);
     SupportEstimate out;
     for (size_t i = 0; i < m.triangles.size(); ++i) {
-        const double area = norm(m.vectorArea[i]);
-        const double projected = dot(m.vectorArea[i], down);  // area × cos(normal, down)
-        if (!(area > 0) || projected <= threshold * area) continue;
+        if (!isOverhang(m.vectorArea[i], down)) continue;
         const Triangle& t = m.triangles[i];
         const double h =
             (dot(up, m.points[t[0]]) + dot(up, m.points[t[1]]) + dot(up, m.points[t[2]])) / 3.0 - lowest;
         if (h <= kBaseHeightMm) continue;  // on the bed: the first layer, not an overhang
-        out.areaMm2 += area;
-        out.volumeMm3 += projected * h;
+        out.areaMm2 += norm(m.vectorArea[i]);
+        out.volumeMm3 += dot(m.vectorArea[i], down) * h;  // the area projected on the bed × height
     }
     return out;
 }
@@ -63,7 +71,6 @@ constexpr double kColumnCellMm = 2.0;
 /// height at the cell centres it covers, each overhanging facet adds, per cell centre it covers,
 /// the gap to the highest of those below it.
 double supportColumnsMm3(const MeshD& m, const Vec3d& down) {
-    static const double threshold = std::sin(kOverhangDeg * kPi / 180.0);
     const std::array<Vec3d, 3> rows = rotationDown(down);  // rows[2] = up
     std::vector<Vec3d> q(m.points.size());
     double x0 = 1e300, y0 = 1e300, z0 = 1e300;
@@ -96,8 +103,7 @@ double supportColumnsMm3(const MeshD& m, const Vec3d& down) {
     std::sort(floors.begin(), floors.end());
     double volume = 0.0;
     for (size_t k = 0; k < m.triangles.size(); ++k) {
-        const double area = norm(m.vectorArea[k]);
-        if (!(area > 0) || dot(m.vectorArea[k], down) <= threshold * area) continue;
+        if (!isOverhang(m.vectorArea[k], down)) continue;
         forCells(m.triangles[k], [&](uint64_t cell, double z) {
             if (z - z0 <= kBaseHeightMm) return;
             // The highest floor in this cell below the overhang (half a cell of slack for the
@@ -112,12 +118,14 @@ double supportColumnsMm3(const MeshD& m, const Vec3d& down) {
     return volume;
 }
 
+SupportEstimate estimateSupport(const MeshD& m, const Vec3d& down) {
+    return {supportOf(m, down).areaMm2, supportColumnsMm3(m, down)};
+}
+
 }  // namespace detail
 
 SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down) {
-    const MeshD mesh(meshMm);
-    const Vec3d d = normalized(down);
-    return {supportOf(mesh, d).areaMm2, supportColumnsMm3(mesh, d)};
+    return detail::estimateSupport(MeshD(meshMm), normalized(down));
 }
 
 }  // namespace zomefab::pieces

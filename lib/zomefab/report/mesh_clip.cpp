@@ -330,16 +330,4 @@ TriMesh clipToBox(const TriMesh& mesh, const Box3d& box) {
     return part;
 }
 
-double meshAreaMm2(const TriMesh& m) {
-    double s = 0.0;
-    for (const Triangle& t : m.triangles) {
-        const Vec3f &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
-        const double ux = double(b[0]) - a[0], uy = double(b[1]) - a[1], uz = double(b[2]) - a[2];
-        const double vx = double(c[0]) - a[0], vy = double(c[1]) - a[1], vz = double(c[2]) - a[2];
-        const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
-        s += 0.5 * std::sqrt(nx * nx + ny * ny + nz * nz);
-    }
-    return s;
-}
-
 }  // namespace zomefab::report

@@ -21,7 +21,4 @@ TriMesh clipByPlane(const TriMesh& mesh, int axis, double coordMm, bool keepBelo
 /// that the mesh does not cross). @throw as clipByPlane().
 TriMesh clipToBox(const TriMesh& mesh, const Box3d& box);
 
-/// Area (mm²).
-double meshAreaMm2(const TriMesh& mesh);
-
 }  // namespace zomefab::report

@@ -96,7 +96,8 @@ json piecesJson(const RunRecord& run) {
 
 /// The share of a piece's solid support columns (Piece::supportVolumeMm3) that a slicer's sparse
 /// automatic support fills: PrusaSlicer 2.5 on the demo's plates, 1,031 cm³ of support filament
-/// against 2,205 cm³ of columns (docs/benchmarks.md, "Support-aware orientation").
+/// against 2,205 cm³ of columns with a 50 mm² first-layer floor; with today's 25 mm², 889 against
+/// 1,754 cm³ (0.51) (docs/benchmarks.md, "Support-aware orientation").
 constexpr double kSparseSupportShare = 0.47;
 
 /// Estimated grams of support filament for @p piece, at the density of its print @p cost.
@@ -228,8 +229,8 @@ std::string perPieceMarkdown(const RunRecord& run) {
         "more than 45° from the vertical as the piece lies. Support: the estimated filament of automatic "
         "supports, " +
         formatNumbers("%.0f %%", 100 * kSparseSupportShare) +
-        " of the solid columns under the overhangs (PrusaSlicer on the demo: 33–150 % per piece, 47 % in "
-        "all). Brim: the first layer is under 4 cm².\n\n| piece | plate |" +
+        " of the solid columns under the overhangs (PrusaSlicer on the demo: 47–51 % in all, 17–184 % per "
+        "plate). Brim: the first layer is under 4 cm².\n\n| piece | plate |" +
         columns + " overhang cm² | support g | brim |\n|---|---:|" + rule + "---:|---:|---|\n";
     double supportG = 0;
     for (size_t i = 0; i < run.pieces.pieces.size(); ++i) {

@@ -213,7 +213,8 @@ std::string serializeVdb(const std::vector<LevelSet>& levelSets) {
         stream.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
         // The checksum entry, filled in by sealVdbStream once the bytes are known.
         openvdb::MetaMap fileMeta;
-        fileMeta.insertMeta(detail::kVdbChecksumKey, openvdb::StringMetadata("00000000"));
+        fileMeta.insertMeta(detail::kVdbChecksumKey,
+                            openvdb::StringMetadata(detail::kVdbChecksumPlaceholder));
         stream.write(grids, fileMeta);
     } catch (const openvdb::Exception& e) {
         throw Error(ErrorCode::WriteFailed, std::string("cannot serialize the grids: ") + e.what());
@@ -250,10 +251,9 @@ std::vector<LevelSet> parseVdb(std::string_view bytes, const std::string& source
         openvdb::io::Stream stream(in, /*delayLoad=*/false);
         grids = stream.getGrids();
     } catch (const std::exception& e) {
-        std::string what = e.what();
-        if (what.find("magic number") != std::string::npos || what.find("not a VDB") != std::string::npos)
-            what = "not a .vdb file";
-        throw Error(ErrorCode::InvalidInput, "cannot read the .vdb stream: " + what, sourceName);
+        // (checkVdbStream has already refused what is not a .vdb stream at all.)
+        throw Error(ErrorCode::InvalidInput, std::string("cannot read the .vdb stream: ") + e.what(),
+                    sourceName);
     }
     std::vector<LevelSet> result;
     std::string others;

@@ -186,15 +186,7 @@ void checkObjectFieldOptions(const ObjectFieldOptions& options) {
 
 MemoryEstimate estimateRunBytes(const TriMesh& meshMm, const Fabrication& fabrication,
                                 const ObjectFieldOptions& options) {
-    double areaMm2 = 0;
-    for (const Triangle& t : meshMm.triangles) {
-        const auto& a = meshMm.positions[t[0]];
-        const auto& b = meshMm.positions[t[1]];
-        const auto& c = meshMm.positions[t[2]];
-        const Vec3d u{double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
-        const Vec3d v{double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
-        areaMm2 += 0.5 * norm(cross(u, v));
-    }
+    const double areaMm2 = surfaceArea(meshMm);
     const double volumeMm3 = std::fabs(signedVolume(meshMm));
     MemoryEstimate e;
     const double v = options.voxelMm, f = options.fieldVoxelMm;

@@ -141,8 +141,7 @@ Header readHeader(Cursor& c) {
     h.fileVersion = c.read<uint32_t>("the file version");
     if (h.fileVersion < kFirstVersion || h.fileVersion > kLastVersion)
         c.fail(versionAt, "file format version " + std::to_string(h.fileVersion) + " (this build reads " +
-                              std::to_string(kFirstVersion) + " to " + std::to_string(kLastVersion) +
-                              ", OpenVDB 2.3 to 10)");
+                              std::to_string(kFirstVersion) + " to " + std::to_string(kLastVersion) + ")");
     c.read<uint32_t>("the library major version");
     c.read<uint32_t>("the library minor version");
     const size_t offsetsAt = c.pos();
@@ -375,14 +374,15 @@ void readFloatTree(Cursor& c, TreeWalk& w) {
     }
 }
 
-/// CRC-32 of @p bytes with the @p valueLength bytes at @p valueAt read as '0'.
-uint32_t checksumWithPlaceholder(std::string_view bytes, size_t valueAt, size_t valueLength) {
-    const std::string zeros(valueLength, '0');
+constexpr size_t kChecksumLength = 8;  // hex digits of a CRC-32
+
+/// CRC-32 of @p bytes with the checksum value at @p valueAt read as kVdbChecksumPlaceholder.
+uint32_t checksumWithPlaceholder(std::string_view bytes, size_t valueAt) {
     uLong crc = crc32_z(0L, Z_NULL, 0);
     crc = crc32_z(crc, reinterpret_cast<const Bytef*>(bytes.data()), valueAt);
-    crc = crc32_z(crc, reinterpret_cast<const Bytef*>(zeros.data()), valueLength);
-    crc = crc32_z(crc, reinterpret_cast<const Bytef*>(bytes.data() + valueAt + valueLength),
-                  bytes.size() - valueAt - valueLength);
+    crc = crc32_z(crc, reinterpret_cast<const Bytef*>(kVdbChecksumPlaceholder), kChecksumLength);
+    crc = crc32_z(crc, reinterpret_cast<const Bytef*>(bytes.data() + valueAt + kChecksumLength),
+                  bytes.size() - valueAt - kChecksumLength);
     return uint32_t(crc);
 }
 
@@ -399,23 +399,22 @@ const MetaEntry* findChecksum(const MetaMapRead& fileMeta) {
     return nullptr;
 }
 
-/// Verifies zomefab's checksum; returns whether the file carries it.
-bool verifyChecksum(Cursor& c, const Header& header, const MetaMapRead& fileMeta) {
+/// Verifies zomefab's checksum when the file carries it (or zomefab's UUID mark).
+void verifyChecksum(Cursor& c, const Header& header, const MetaMapRead& fileMeta) {
     const MetaEntry* entry = findChecksum(fileMeta);
     if (!entry) {
         if (header.zomefabUuid)
             c.fail(kUuidOffset, "written by zomefab but its checksum entry is missing or damaged");
-        return false;
+        return;
     }
     const std::string_view bytes = c.bytes();
-    if (entry->type != "string" || entry->size != 8)
+    if (entry->type != "string" || entry->size != kChecksumLength)
         c.fail(entry->entryStart, "the checksum entry is damaged");
-    const std::string_view stored = bytes.substr(entry->valueStart, 8);
-    if (stored != hex8(checksumWithPlaceholder(bytes, entry->valueStart, 8)))
+    const std::string_view stored = bytes.substr(entry->valueStart, kChecksumLength);
+    if (stored != hex8(checksumWithPlaceholder(bytes, entry->valueStart)))
         c.error(
             "damaged .vdb stream: its checksum does not match its contents (the file changed after zomefab "
             "wrote it)");
-    return true;
 }
 
 /// FNV-1a, 64 bits: the content hash behind the deterministic archive UUID.
@@ -448,12 +447,11 @@ VdbCheck checkVdbStream(std::string_view bytes, const std::string& sourceName) {
     VdbCheck result;
     const Header header = readHeader(c);
     const MetaMapRead fileMeta = readMetaMap(c, "the file metadata");
-    result.writtenByZomefab = verifyChecksum(c, header, fileMeta);
+    verifyChecksum(c, header, fileMeta);
 
     const size_t countAt = c.pos();
     const auto gridCount = c.read<int32_t>("the grid count");
     if (gridCount < 0 || gridCount > kMaxGrids) c.fail(countAt, "grid count " + std::to_string(gridCount));
-    result.gridCount = gridCount;
     // The per-grid "file_delayed_load" entries only serve delayed loading from files, which a
     // stream does not do; OpenVDB trusts the counts inside them, so they are removed.
     std::vector<std::pair<size_t, size_t>> strip;
@@ -496,7 +494,6 @@ VdbCheck checkVdbStream(std::string_view bytes, const std::string& sourceName) {
         readTransform(c, name);
         if (!parent.empty()) continue;  // an instance shares its parent's tree
         readFloatTree(c, walk);
-        result.leafCount += walk.leaves;
         result.treeBytes +=
             walk.leaves * kLeafBytes + walk.internal4 * kInternal4Bytes + walk.internal5 * kInternal5Bytes;
     }
@@ -516,7 +513,8 @@ void sealVdbStream(std::string& bytes) {
         throw Error(ErrorCode::Internal, std::string("unexpected .vdb layout from OpenVDB: ") + e.what());
     }
     const MetaEntry* entry = findChecksum(fileMeta);
-    if (!entry || entry->size != 8 || bytes.compare(entry->valueStart, 8, "00000000") != 0)
+    if (!entry || entry->size != kChecksumLength ||
+        bytes.compare(entry->valueStart, kChecksumLength, kVdbChecksumPlaceholder) != 0)
         throw Error(ErrorCode::Internal, "unexpected .vdb layout from OpenVDB: no checksum placeholder");
     const size_t valueAt = entry->valueStart;
     // The UUID (8-4-4-4-12 hex digits): the mark, then 28 digits of hash over everything after it.
@@ -528,8 +526,8 @@ void sealVdbStream(std::string& bytes) {
                   unsigned((h1 >> 32) & 0xffff), unsigned(h1 & 0xffff),
                   static_cast<unsigned long long>(h2 & 0xffffffffffffull));
     std::memcpy(&bytes[kUuidOffset], uuid, kUuidLength);
-    const std::string crc = hex8(checksumWithPlaceholder(bytes, valueAt, 8));
-    std::memcpy(&bytes[valueAt], crc.data(), 8);
+    const std::string crc = hex8(checksumWithPlaceholder(bytes, valueAt));
+    std::memcpy(&bytes[valueAt], crc.data(), kChecksumLength);
 }
 
 }  // namespace zomefab::sdf::detail

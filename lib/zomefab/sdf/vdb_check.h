@@ -17,16 +17,15 @@ namespace zomefab::sdf::detail {
 /// File-level metadata entry that holds the CRC-32 (8 lowercase hex digits) of the whole stream,
 /// computed with the entry's own 8 value bytes set to '0'.
 inline constexpr const char* kVdbChecksumKey = "zomefab_crc32";
+/// The value the writer puts there before the checksum is known, and what the checksum reads it as.
+inline constexpr const char* kVdbChecksumPlaceholder = "00000000";
 /// The first 9 characters of the archive UUID of every file zomefab writes: a second mark, so a
 /// file whose checksum entry was itself damaged is still known to be zomefab's.
 inline constexpr const char* kVdbUuidMark = "7a6f6d65-";
 
 /// What checkVdbStream found.
 struct VdbCheck {
-    std::string sanitized;          ///< the bytes for OpenVDB: per-grid "file_delayed_load" entries removed
-    bool writtenByZomefab = false;  ///< checksum present and correct
-    int gridCount = 0;
-    uint64_t leafCount = 0;  ///< leaf nodes of all trees
+    std::string sanitized;   ///< the bytes for OpenVDB: per-grid "file_delayed_load" entries removed
     uint64_t treeBytes = 0;  ///< estimated memory of the trees once parsed
 };
 
@@ -39,7 +38,7 @@ VdbCheck checkVdbStream(std::string_view bytes, const std::string& sourceName);
 
 /// Writer side: replaces OpenVDB's random archive UUID by kVdbUuidMark + a hash of the content
 /// (same grids, same bytes) and fills in the kVdbChecksumKey entry, which must be present in the
-/// file metadata with the value "00000000".
+/// file metadata with the value kVdbChecksumPlaceholder.
 /// @throw Error(Internal) when the bytes do not have that layout.
 void sealVdbStream(std::string& bytes);
 

@@ -62,8 +62,6 @@ struct Grouping {
     double outsideCellsVolumeMm3 = 0.0;
     size_t sliversMerged = 0;
     size_t isolatedSlivers = 0;
-    size_t specksMerged =
-        0;  ///< specks that touched no piece, joined to one of their cell (dropped by meshing)
 };
 
 /// The whole grouping (docs/pieces.md §1, steps 2–4): components, groups, merges of orphans and

@@ -43,6 +43,9 @@ SupportEstimate supportOf(const MeshD& m, const Vec3d& down);
 /// estimateSupport's volume: columns down to the first up-facing surface below, or the bed.
 double supportColumnsMm3(const MeshD& m, const Vec3d& down);
 
+/// estimateSupport on the double-precision mesh (@p down unit).
+SupportEstimate estimateSupport(const MeshD& m, const Vec3d& down);
+
 /// Hill-climbs @p objective down from @p down by tilts of @p stepsDeg (each up to @p iterations
 /// times) about two perpendicular axes, keeping to directions where @p allowed; @p value is
 /// objective(@p down) on entry and at the result on return.
@@ -53,7 +56,7 @@ Vec3d tiltTowardsLess(Vec3d down, double& value, Objective&& objective, Allowed&
         const double step = std::tan(stepDeg * kPi / 180.0);
         for (int iteration = 0; iteration < iterations; ++iteration) {
             const std::array<Vec3d, 3> rows = rotationDown(down);
-            std::vector<std::pair<double, Vec3d>> smaller;  // the tilts that need less support
+            std::vector<std::pair<double, Vec3d>> smaller;  // the tilts that lower the objective
             for (const Vec3d& side : {rows[0], scale(rows[0], -1.0), rows[1], scale(rows[1], -1.0)}) {
                 const Vec3d d = normalized(madd(down, step, side));
                 const double v = objective(d);
