@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
                    "Frame file (zomefab.structure JSON); its transform_mm places the mesh")
         ->required();
     app.add_option("-o,--output", output, "PARTITION.json (- = stdout)")->required();
-    fabricationCli.addTo(app, cli::kPrinter);
+    fabricationCli.addTo(app, cli::kPrinter | cli::kWall);
     partitionCli.addTo(app);
     app.add_option("--colored-ply", coloredPly, "Also write the mesh (frame mm) with one colour per group");
     app.add_option("--color-by", colorBy, "Groups for --colored-ply")

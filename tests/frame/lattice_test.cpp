@@ -52,21 +52,36 @@ TEST_CASE("lattice: the rotation search is an option and goes into the frame tra
     for (int a = 0; a < 3; ++a) CHECK(back[a] == doctest::Approx(p[a]));
 }
 
-TEST_CASE("lattice: an object too thin for one cube fails with the sizes involved") {
-    // A 400 × 400 × 80 mm slab: 40 mm deep at most, a cube needs 24.85 mm clearance around a 47.3 mm cube.
+TEST_CASE("lattice: an object thinner than a cube gets balls joined by struts in its middle") {
+    // A 400 × 400 × 80 mm slab: 40 mm deep at most; a cube needs 24.85 mm clearance around a 47.3 mm
+    // cube, a ball only 24.85 mm. The frame is a grid of balls in the slab's mid-plane.
     const sdf::InteriorField field =
         test::interiorFieldOf(test::makeBox({-200, -200, -40}, {200, 200, 40}), 4.0);
+    const frame::LatticeResult r = frame::initialLattice(field, {}, RunContext::silent());
+    CHECK(r.cubes == 0);
+    CHECK(r.structure.ballCount() >= 9);
+    CHECK(r.structure.strutCount() >= 12);
+    for (zome::BallId id : r.structure.ballIds()) {
+        const Vec3d p = r.structure.ball(id).positionMm;
+        CHECK(std::abs(p[2]) <= 40.0 - 24.85 + 1e-6);  // every ball deep enough
+    }
+}
+
+TEST_CASE("lattice: an object too thin for one ball fails with the sizes involved") {
+    // A 400 × 400 × 40 mm slab: 20 mm deep at most, a ball needs 24.85 mm (dMin 16 + radius 8.85).
+    const sdf::InteriorField field =
+        test::interiorFieldOf(test::makeBox({-200, -200, -20}, {200, 200, 20}), 4.0);
     try {
         frame::initialLattice(field, {}, RunContext::silent());
         FAIL("expected an error");
     } catch (const Error& e) {
         CHECK(e.code() == ErrorCode::ProcessingFailed);
         const std::string m = e.message();
-        CHECK(m.find("too thin for one B0 cube") != std::string::npos);
-        CHECK(m.find("at least 24.9 mm inside") != std::string::npos);          // dMin 16 + ball radius 8.85
-        CHECK(m.find("deepest point is 40.0 mm inside") != std::string::npos);  // half the slab
-        CHECK(m.find("needs 65.8 mm") != std::string::npos);                    // 24.85 + 47.3·√3/2
-        CHECK(m.find("scaled up 1.65 times") != std::string::npos);
+        CHECK(m.find("too thin for a Zome frame") != std::string::npos);
+        CHECK(m.find("has a ball at least 24.9 mm inside") != std::string::npos);
+        CHECK(m.find("deepest point is 20.0 mm inside") != std::string::npos);  // half the slab
+        CHECK(m.find("needs 31.7 mm") != std::string::npos);                    // 24.85 + 47.3·√3/12
+        CHECK(m.find("scaled up 1.58 times") != std::string::npos);
     }
 }
 

@@ -311,6 +311,7 @@ TEST_CASE("partition: partitions that fit at a high w_smoothness are kept while 
         partition::test::loadMeshMm(zomefab::test::dataPath("bunny_npm_3674.stl"), 300.0, true);
     const partition::test::LatticeFrame frame = partition::test::makeLatticeFrame(bunny.mesh, 12.0);
     PartitionOptions o;
+    o.mountBlockedShare = -1.0;  // the printer alone decides what fits (tests/partition/mount_fit_test.cpp)
     Fabrication fab;
     fab.printerMm = {120, 120, 120};
     const PartitionResult r =

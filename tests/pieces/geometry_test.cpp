@@ -355,18 +355,31 @@ TEST_CASE("tenons: the choice keeps to each piece's direction, spreads the tenon
     };
     candidates.push_back(make(5, 2, {0, 300, 0}, 1, 0.99));
     candidates.back().rejection = "surface too oblique";
+    // Alone, piece 0 takes its best (A), then the one farthest from it (C), then F.
+    const TenonPlan alone = chooseTenons(candidates, {2, -1, -1}, o);
+    REQUIRE(alone.perPiece[0].size() == 3);
+    CHECK(alone.perPiece[0][0].ball == 0);
+    CHECK(alone.perPiece[0][1].ball == 2);  // the spread outweighs F's better score
+    CHECK(alone.perPiece[0][2].ball == 6);
+    for (const Tenon& t : alone.perPiece[0]) CHECK(t.hole == 2);  // B never: another direction
+    // With piece 1: each round, the piece with fewer candidates left chooses first. Piece 1 (D, E)
+    // takes D, which A sits next to: piece 0 gets F and C, and both pieces two tenons.
     const TenonPlan plan = chooseTenons(candidates, {2, 2, -1}, o);
     REQUIRE(plan.perPiece.size() == 3);
-    REQUIRE(plan.perPiece[0].size() == 3);
-    CHECK(plan.perPiece[0][0].ball == 0);
-    CHECK(plan.perPiece[0][1].ball == 2);  // the spread outweighs F's better score
-    CHECK(plan.perPiece[0][2].ball == 6);
-    for (const Tenon& t : plan.perPiece[0]) CHECK(t.hole == 2);  // B never: another direction
-    REQUIRE(plan.perPiece[1].size() == 1);
-    CHECK(plan.perPiece[1][0].ball == 4);  // D lost to A, which was chosen first
+    REQUIRE(plan.perPiece[0].size() == 2);
+    CHECK(plan.perPiece[0][0].ball == 6);
+    CHECK(plan.perPiece[0][1].ball == 2);
+    REQUIRE(plan.perPiece[1].size() == 2);
+    CHECK(plan.perPiece[1][0].ball == 3);
+    CHECK(plan.perPiece[1][1].ball == 4);
     CHECK(plan.shortfall[0].empty());
-    CHECK(plan.shortfall[1].at("another tenon in the way") == 1);
-    CHECK(plan.shortfall[1].at("surface too oblique") == 1);
+    CHECK(plan.shortfall[1].empty());
+    // One tenon wanted more than there are: the shortfall names each rejected ray.
+    TenonOptions three = o;
+    three.minPerPiece = 3;
+    const TenonPlan short3 = chooseTenons(candidates, {2, 2, -1}, three);
+    CHECK(short3.shortfall[0].at("another tenon in the way") == 1);  // A, next to D
+    CHECK(short3.shortfall[1].at("surface too oblique") == 1);
     CHECK(plan.perPiece[2].empty());
     CHECK(plan.shortfall[2].count("no ball's hole along the piece's direction points at it") == 1);
     // No two chosen prisms come closer than twice their radius.

@@ -198,7 +198,7 @@ TEST_CASE("zf-pieces: the real chain zf-sdf, zf-shell, zf-frame, zf-partition, z
     REQUIRE(test::runShell(test::toolPath("zf-frame") + " " + dir.file("bunny.vdb") +
                            " --shell-mm 10 --frame-clearance-mm 10 -q -o " + dir.file("frame.json")) == 0);
     REQUIRE(test::runShell(test::toolPath("zf-partition") + " " + bunny + " " + dir.file("frame.json") +
-                           " -q -o " + dir.file("partition.json")) == 0);
+                           " --shell-mm 10 -q -o " + dir.file("partition.json")) == 0);
     REQUIRE(test::runShell(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " +
                            dir.file("frame.json") + " " + dir.file("partition.json") + " -q -o " +
                            dir.file("out")) == 0);

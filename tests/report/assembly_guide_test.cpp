@@ -151,6 +151,27 @@ TEST_CASE("assembly_guide: the mounting steps, in order, and their checks") {
     fails(bad, "has no direction");
 }
 
+TEST_CASE("assembly_guide: a piece no peg holds is glued onto a piece already on") {
+    const zome::Structure cube = cubeFrame();
+    std::vector<MountingStep> steps(2);
+    steps[0].pieces = {"piece-01"};
+    steps[0].hole = 17;
+    steps[0].tenons = {{"piece-01", 0, 17}};
+    steps[1].pieces = {"piece-04"};
+    steps[1].hole = 2;
+    steps[1].gluedOnto = {{"piece-04", "piece-01", 2}};
+    const AssemblyGuide g = assemblyGuide(cube, steps);
+    const std::string md = assemblyGuideMarkdown(g);
+    CHECK(md.find("Put glue on the cut face of piece-04 that meets piece-01 (already on): piece-04 is glued "
+                  "onto it as it goes on (2 alignment pins on piece-01 go into its sockets).") !=
+          std::string::npos);
+    CHECK(md.find("It has no pegs: the glue holds it.") != std::string::npos);
+    const nlohmann::json j = assemblyGuideToJson(g);
+    CHECK(j["mounting"][1]["glued_onto"][0]["onto"] == "piece-01");
+    CHECK(j["mounting"][1]["glued_onto"][0]["pins"] == 2);
+    CHECK(j["mounting"][1]["pegs"].empty());
+}
+
 TEST_CASE("assembly_guide: same frame, same text") {
     const zome::Structure a = cubeFrame(), b = cubeFrame();
     CHECK(assemblyGuideMarkdown(assemblyGuide(a)) == assemblyGuideMarkdown(assemblyGuide(b)));

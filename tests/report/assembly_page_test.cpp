@@ -52,7 +52,7 @@ struct CubeWithLid {
     CubeWithLid() {
         double top = -1e300;
         for (const zome::BallId b : frame.ballIds()) top = std::max(top, frame.ball(b).positionMm[2]);
-        MountingStep step{{"piece-00"}, {}, 2, {}};  // hole 2: blue, straight up
+        MountingStep step{{"piece-00"}, {}, 2, {}, {}};  // hole 2: blue, straight up
         Box3d box;
         for (const zome::BallId b : frame.ballIds()) {
             const Vec3d& p = frame.ball(b).positionMm;

@@ -215,3 +215,34 @@ TEST_CASE("verify: zomefab check passes the output, exits 3 on a broken copy and
     CHECK(err.find("order") != std::string::npos);
     CHECK(test::runShell(zf + " check '" + dir.file("none") + "' 2>/dev/null") == 2);
 }
+
+TEST_CASE(
+    "verify: a piece with no peg glued onto a piece put on before it is held; onto a later one it is not") {
+    verify::Assembly a = good().assembly;
+    const mount::InstallationPlan& plan = a.pieces.plan;
+    // A piece mounted alone, with a neighbour put on in an earlier step and one in a later step.
+    uint32_t id = 0, earlier = 0, later = 0;
+    bool isFound = false;
+    for (uint32_t p = 0; p < a.pieces.pieces.size() && !isFound; ++p) {
+        const int step = plan.stepOf(p);
+        if (step < 0 || plan.steps[size_t(step)].pieces.size() != 1) continue;
+        bool hasEarlier = false, hasLater = false;
+        for (const auto& [q, area] : a.pieces.pieces[p].neighbors) {
+            if (plan.stepOf(q) < step && !hasEarlier) hasEarlier = true, earlier = q;
+            if (plan.stepOf(q) > step && !hasLater) hasLater = true, later = q;
+        }
+        if (hasEarlier && hasLater) id = p, isFound = true;
+    }
+    REQUIRE(isFound);
+    a.pieces.pieces[id].tenons.clear();  // its pegs were in the balls: "peg fit" fails too
+    const auto gluedBefore = a.pieces.plan.gluedOn;
+    a.pieces.plan.gluedOn.push_back({earlier, id});
+    std::set<std::string> names = failed(check(a));
+    CHECK(names.count("held") == 0);
+    CHECK(names.count("plan") == 0);
+    a.pieces.plan.gluedOn = gluedBefore;
+    a.pieces.plan.gluedOn.push_back({later, id});
+    names = failed(check(a));
+    CHECK(names.count("held") == 0);
+    CHECK(names.count("plan") == 1);  // "glued onto piece N, which is not put on before it"
+}

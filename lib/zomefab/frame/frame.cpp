@@ -177,6 +177,12 @@ FrameResult buildFrame(const sdf::InteriorField& field, const Fabrication& fabri
     r.seed = seedFor(fabrication, SeedStream::Frame);
     r.lattice = initialLattice(field, lattice, context);
     r.latticeSeconds = clock.seconds();
+    if (r.lattice.cubes == 0)
+        context.detail(
+            "no whole B0 cube fits (the object is thinner than a cube and its clearance): the frame "
+            "starts from " +
+            std::to_string(r.lattice.structure.ballCount()) + " balls and " +
+            std::to_string(r.lattice.structure.strutCount()) + " B0 struts");
     r.rotationDeg = r.lattice.rotationDeg;
     const FrameField ff(field, r.rotationDeg, r.lattice.structure.scale(), r.zone);
 

@@ -31,6 +31,9 @@ struct Placement {
     std::vector<uint8_t> edge;    ///< [3·point + axis]: the strut to the +axis neighbour is in a cube
     std::vector<uint8_t> isBall;  ///< per point: a corner of a cube
     size_t cubes = 0;
+    /// With no whole cube: the balls of the largest connected set of allowed balls and B0 struts
+    /// (isBall and edge then hold that set); 0 when there are cubes.
+    size_t strutFrameBalls = 0;
     /// Mean E_fid summand of the outermost cube balls: the tie-break between placements with as
     /// many cubes (the one whose boundary lies closer to the surface).
     double fidelity = 0;
@@ -67,6 +70,43 @@ Box3d frameBox(const FrameField& ff) {
         out.expand(ff.toFrameMm(p));
     }
     return out;
+}
+
+/// The neighbour of lattice point @p id along +axis @p a (in range when its edge flag is set).
+size_t stepAlong(const Placement& pl, size_t id, int a) {
+    const size_t s = size_t(pl.n[2]);
+    return a == 0 ? id + size_t(pl.n[1]) * s : a == 1 ? id + s : id + 1;
+}
+
+/// With no whole cube: the largest connected set of allowed balls and allowed B0 struts (the first
+/// largest in point order) as the placement's balls and edges, and its size. A thin object still
+/// gets a frame: a few balls in a row or a square, or one ball.
+void keepLargestStrutSet(Placement& pl, const std::vector<uint8_t>& ballOk,
+                         const std::vector<uint8_t>& edgeOk) {
+    const size_t count = ballOk.size();
+    std::vector<size_t> parent(count);
+    std::iota(parent.begin(), parent.end(), size_t(0));
+    auto find = [&](size_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+    };
+    for (size_t id = 0; id < count; ++id)
+        for (int a = 0; a < 3; ++a)
+            if (edgeOk[3 * id + size_t(a)]) {
+                const size_t x = find(id), y = find(stepAlong(pl, id, a));
+                if (x != y) parent[std::max(x, y)] = std::min(x, y);
+            }
+    std::vector<size_t> size(count, 0);
+    size_t keep = SIZE_MAX;
+    for (size_t id = 0; id < count; ++id)
+        if (ballOk[id] && ++size[find(id)] > (keep == SIZE_MAX ? 0 : size[keep])) keep = find(id);
+    if (keep == SIZE_MAX) return;
+    pl.strutFrameBalls = size[keep];
+    for (size_t id = 0; id < count; ++id) {
+        if (!ballOk[id] || find(id) != keep) continue;
+        pl.isBall[id] = 1;
+        for (int a = 0; a < 3; ++a) pl.edge[3 * id + size_t(a)] = edgeOk[3 * id + size_t(a)];
+    }
 }
 
 /// Evaluates one placement: ball and edge validity, whole cubes.
@@ -138,6 +178,7 @@ Placement evaluate(const FrameField& ff, double rotationDeg, const Vec3d& offset
     // Balls and struts of the whole cubes, the hole masks they give, and the fidelity tie-break.
     pl.isBall.assign(count, 0);
     pl.edge.assign(3 * count, 0);
+    if (pl.cubes == 0) keepLargestStrutSet(pl, ballOk, edgeOk);
     for (int i = pl.lo[0]; i + 1 < pl.lo[0] + pl.n[0]; ++i)
         for (int j = pl.lo[1]; j + 1 < pl.lo[1] + pl.n[1]; ++j)
             for (int k = pl.lo[2]; k + 1 < pl.lo[2] + pl.n[2]; ++k) {
@@ -193,7 +234,7 @@ LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptio
     const double b0 = options.scale.b0Mm;
 
     // Offsets are relative to the min corner of the frame-space box of each rotation.
-    std::vector<size_t> cubes(total, 0);
+    std::vector<size_t> cubes(total, 0), strutFrameBalls(total, 0);
     std::vector<double> fidelity(total, 0.0);
     std::vector<FrameField> fields;
     std::vector<Vec3d> corners;
@@ -212,33 +253,36 @@ LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptio
         if (context.isCancelled()) return;
         const Placement pl = evaluate(fields[p / perRotation], rotations[p / perRotation], offsetOf(p));
         cubes[p] = pl.cubes;
+        strutFrameBalls[p] = pl.strutFrameBalls;
         fidelity[p] = pl.fidelity;
     });
     context.throwIfCancelled();
-    // Most cubes, then the lowest boundary fidelity, then the first in placement order:
-    // deterministic whatever the thread count.
+    // Most cubes (with none: the most balls joined by struts), then the lowest boundary fidelity,
+    // then the first in placement order: deterministic whatever the thread count.
     size_t best = 0;
-    for (size_t p = 1; p < total; ++p)
-        if (cubes[p] > cubes[best] || (cubes[p] == cubes[best] && fidelity[p] < fidelity[best])) best = p;
-    if (cubes[best] == 0) {
+    for (size_t p = 1; p < total; ++p) {
+        const auto key = [&](size_t q) { return std::make_pair(cubes[q], strutFrameBalls[q]); };
+        if (key(p) > key(best) || (key(p) == key(best) && fidelity[p] < fidelity[best])) best = p;
+    }
+    if (cubes[best] == 0 && strutFrameBalls[best] == 0) {
         const double deepest = deepestDepthMm(field);
         const double need = options.zone.dMinMm + options.scale.ballRadiusMm();
-        // A cube whose centre sits at the deepest point has its corners b0·√3/2 from it, so they
-        // all lie deep enough when the deepest point is need + b0·√3/2 inside; every placement
-        // tried failed, and the deepest point says by how much the object falls short.
-        const double halfDiagonal = 0.5 * std::sqrt(3.0) * b0;
-        const double wanted = need + halfDiagonal;
+        // The lattice points of the placements tried lie within half an offset step's diagonal of
+        // any point, so a ball lands deep enough when the deepest point is that much deeper still;
+        // every placement failed, and the deepest point says by how much the object falls short.
+        const double stepDiagonal = 0.5 * std::sqrt(3.0) * b0 / double(steps);
+        const double wanted = need + stepDiagonal;
         std::string hint;
         if (deepest > 0 && deepest < wanted)
             hint = "; the object scaled up " + formatNumbers("%.2f", wanted / deepest) +
                    " times (--height-mm) holds one for sure, or use a smaller --frame-clearance-mm";
         throw Error(ErrorCode::ProcessingFailed,
-                    "object too thin for one B0 cube: none of the " + std::to_string(total) +
-                        " placements tried has all 8 balls at least " + formatNumbers("%.1f", need) +
+                    "object too thin for a Zome frame: none of the " + std::to_string(total) +
+                        " placements tried has a ball at least " + formatNumbers("%.1f", need) +
                         " mm inside the surface (dMin + ball radius); the deepest point is " +
-                        formatNumbers("%.1f", deepest) + " mm inside, and a cube around it needs " +
+                        formatNumbers("%.1f", deepest) + " mm inside, and a ball there needs " +
                         formatNumbers("%.1f", wanted) + " mm (" + formatNumbers("%.1f", need) +
-                        " + half the cube's diagonal " + formatNumbers("%.1f", halfDiagonal) + ")" + hint);
+                        " + the lattice's offset step " + formatNumbers("%.1f", stepDiagonal) + ")" + hint);
     }
 
     const FrameField& ff = fields[best / perRotation];

@@ -20,26 +20,28 @@ struct LatticeOptions {
     int offsetSteps = 6;
     /// Also try rotations of the lattice about the up axis z (the paper does not rotate).
     bool searchRotation = false;
-    double rotationStepDeg = 7.5;  ///< step of the rotation search over [0°, 90°)
-    zome::ZomeScale scale;            ///< physical sizes (b0 47.3 mm, ball 17.7 mm, strut radii)
-    sdf::ForbiddenZoneOptions zone;   ///< dMin: the clearance every ball and strut keeps
-    zome::CollisionOptions collision; ///< passed to the structure
+    double rotationStepDeg = 7.5;      ///< step of the rotation search over [0°, 90°)
+    zome::ZomeScale scale;             ///< physical sizes (b0 47.3 mm, ball 17.7 mm, strut radii)
+    sdf::ForbiddenZoneOptions zone;    ///< dMin: the clearance every ball and strut keeps
+    zome::CollisionOptions collision;  ///< passed to the structure
 };
 
 struct LatticeResult {
     /// The kept cubes, balls numbered in lattice order; scale().originMm is the lattice offset.
     zome::Structure structure;
-    double rotationDeg = 0;          ///< lattice rotation about z (frame = R(−rotation)·field)
-    Vec3d offsetMm{0, 0, 0};         ///< position of lattice index (0,0,0) in the frame's mm
-    size_t cubes = 0;                ///< whole cubes of the chosen placement
-    size_t keptCubes = 0;            ///< whole cubes in the kept (largest connected) part
+    double rotationDeg = 0;   ///< lattice rotation about z (frame = R(−rotation)·field)
+    Vec3d offsetMm{0, 0, 0};  ///< position of lattice index (0,0,0) in the frame's mm
+    size_t cubes = 0;         ///< whole cubes of the chosen placement
+    size_t keptCubes = 0;     ///< whole cubes in the kept (largest connected) part
     size_t placementsTried = 0;
     size_t firstPlacementCubes = 0;  ///< whole cubes of the unsearched placement (corner, 0°)
 };
 
-/// The B0 cube lattice in @p field (the "interior" field in mm, z up).
-/// @throw Error(ProcessingFailed) when no whole cube fits ("too thin"), naming the deepest inner
-///        point found and the size a cube needs; Error(Usage) for offsetSteps < 1 or a
+/// The B0 cube lattice in @p field (the "interior" field in mm, z up). Where no whole cube fits
+/// (an object thinner than a cube and its clearance), the placement with the most balls joined by
+/// allowed B0 struts: a row, a square, one ball (LatticeResult::cubes is then 0).
+/// @throw Error(ProcessingFailed) when not even one ball fits ("too thin"), naming the deepest inner
+///        point found and the depth a ball needs; Error(Usage) for offsetSteps < 1 or a
 ///        non-positive rotation step; Error(Cancelled).
 LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptions& options,
                              RunContext& context);

@@ -2,7 +2,8 @@
 /// @file The installation plan: how each printed piece goes onto the built frame. Every piece has
 /// one direction, a hole direction d: it is pushed on along −d, its tenons' pegs entering the holes
 /// that point along d. Pieces glued together before mounting form a group that goes on as one
-/// body. The steps give the order; `before` lists the blocking relation the order respects (a
+/// body; a body no peg can hold is glued onto pieces already in place as it goes on. The steps give
+/// the order; `before` lists the blocking relation the order respects (a
 /// piece cannot approach through a neighbour already in place). docs/mounting.md.
 #pragma once
 
@@ -27,6 +28,10 @@ struct InstallationPlan {
     /// Pairs of pieces glued together before mounting (across their common cut face, with
     /// alignment pins): the edges that join each group, a < b.
     std::vector<std::pair<uint32_t, uint32_t>> glued;
+    /// Pairs (host, piece): piece, which no peg can hold, is glued onto host as it goes on, host
+    /// being a piece of an earlier step: across their common cut face, with alignment pins along
+    /// piece's direction (an ear onto the head, the tip of a tail onto its root).
+    std::vector<std::pair<uint32_t, uint32_t>> gluedOn;
     std::vector<MountStep> steps;  ///< in mounting order; every piece in exactly one
     /// (a, b): group a must be mounted before group b (b's path would cross a, or a's would cross
     /// b); groups by their names (groupOf).

@@ -15,6 +15,35 @@
 
 namespace zomefab::partition::detail {
 
+/// A piece of @p faces: its cells, their balls, its area, the box of its vertices (@p pts receives
+/// them) and its patches: its fragments (@p fragOf: connected faces of one cell), each with its
+/// cell and box, in order of their lowest face.
+Piece describePiece(const Surface& S, const Classes& C, const LinearCells& cells,
+                    const std::vector<uint32_t>& faceCells, const std::vector<uint32_t>& fragOf,
+                    const std::vector<uint32_t>& faces, FitTester& cx, std::vector<Vec3d>& pts) {
+    Piece piece;
+    piece.faceCount = uint32_t(faces.size());
+    for (uint32_t f : faces) {
+        piece.areaMm2 += S.graph.areasMm2[f];
+        piece.cells.push_back(faceCells[f]);
+    }
+    std::sort(piece.cells.begin(), piece.cells.end());
+    piece.cells.erase(std::unique(piece.cells.begin(), piece.cells.end()), piece.cells.end());
+    for (uint32_t c : piece.cells) piece.balls.push_back(C.classBall[cells.classes[c]]);
+    std::sort(piece.balls.begin(), piece.balls.end());
+    piece.balls.erase(std::unique(piece.balls.begin(), piece.balls.end()), piece.balls.end());
+    pts = faceVertices(S.mesh, faces, cx.stamp, cx.stampValue);
+    for (const Vec3d& v : pts) piece.boundsMm.expand(v);
+    std::map<uint32_t, size_t> patchOfFragment;
+    for (uint32_t f : faces) {
+        const auto [it, isNew] = patchOfFragment.emplace(fragOf[f], piece.patches.size());
+        if (isNew) piece.patches.push_back({faceCells[f], Box3d{}});
+        for (uint32_t v : S.mesh.triangles[f])
+            piece.patches[it->second].boundsMm.expand(toD(S.mesh.positions[v]));
+    }
+    return piece;
+}
+
 /// Pieces from the cells: fragments (connected faces of one cell), merged for crossed salient
 /// regions and small areas when the result fits, numbered by lowest face, with their fits.
 /// @p pieceFaces receives each piece's faces.
@@ -55,7 +84,7 @@ std::vector<Piece> piecesFromCells(const Surface& S, const Classes& C, const Fab
         a = dsu.find(a), b = dsu.find(b);
         if (a == b) return true;
         std::vector<uint32_t> joined = facesOf(a, b);
-        if (!cx.fitOf(joined).fits) return false;
+        if (!cx.fits(joined)) return false;
         unite(a, b, std::move(joined));
         merges += isCounted ? 1 : 0;
         return true;
@@ -151,21 +180,8 @@ std::vector<Piece> piecesFromCells(const Surface& S, const Classes& C, const Fab
     for (uint32_t f = 0; f < S.faceCount; ++f) pieceFaces[facePieces[f]].push_back(f);
     std::vector<Piece> pieces(pieceCount);
     std::vector<std::vector<Vec3d>> piecePts(pieceCount);
-    for (uint32_t p = 0; p < pieceCount; ++p) {
-        Piece& piece = pieces[p];
-        piece.faceCount = uint32_t(pieceFaces[p].size());
-        for (uint32_t f : pieceFaces[p]) {
-            piece.areaMm2 += S.graph.areasMm2[f];
-            piece.cells.push_back(faceCells[f]);
-        }
-        std::sort(piece.cells.begin(), piece.cells.end());
-        piece.cells.erase(std::unique(piece.cells.begin(), piece.cells.end()), piece.cells.end());
-        for (uint32_t c : piece.cells) piece.balls.push_back(C.classBall[cells.classes[c]]);
-        std::sort(piece.balls.begin(), piece.balls.end());
-        piece.balls.erase(std::unique(piece.balls.begin(), piece.balls.end()), piece.balls.end());
-        piecePts[p] = faceVertices(S.mesh, pieceFaces[p], cx.stamp, cx.stampValue);
-        for (const Vec3d& v : piecePts[p]) piece.boundsMm.expand(v);
-    }
+    for (uint32_t p = 0; p < pieceCount; ++p)
+        pieces[p] = describePiece(S, C, cells, faceCells, fragOf, pieceFaces[p], cx, piecePts[p]);
     tbb::parallel_for(uint32_t(0), pieceCount, [&](uint32_t p) {
         pieces[p].fit = fitInPrinter(piecePts[p], fab.printerMm, fab.fitMarginMm);
     });
@@ -213,16 +229,22 @@ void cutAndMakePieces(const Surface& S, Classes& C, const Fabrication& fab, cons
         std::vector<Piece> pieces =
             piecesFromCells(S, C, fab, opt, fits, cells, faceCells, crossed, facePieces, pieceFaces, merges);
 
-        std::vector<uint32_t> tooLarge;
+        std::vector<uint32_t> tooLarge, unmountable;
         for (uint32_t p = 0; p < pieces.size(); ++p)
-            if (!pieces[p].fit.fits) tooLarge.push_back(p);
+            if (!pieces[p].fit.fits)
+                tooLarge.push_back(p);
+            else if (!fits.isMountable(pieceFaces[p]))
+                unmountable.push_back(p);
+        // Pieces no direction mounts are cut again while rounds are left; after that the pieces
+        // stage re-cuts or glues them (it knows the solid wall).
+        if (round >= opt.maxRepairRounds) unmountable.clear();
         if (!tooLarge.empty() && round >= opt.maxRepairRounds)
             throw Error(ErrorCode::ProcessingFailed,
                         std::to_string(tooLarge.size()) + " piece(s) still do not fit the printer " +
                             sizeText(fab.printerMm) + " after " + std::to_string(round) +
                             " repair rounds (piece " + std::to_string(tooLarge.front()) + " needs " +
                             sizeText(pieces[tooLarge.front()].fit.extentsMm) + ")");
-        if (tooLarge.empty()) {
+        if (tooLarge.empty() && unmountable.empty()) {
             size_t agree = 0;
             for (uint32_t f = 0; f < S.faceCount; ++f)
                 agree += cells.classes[faceCells[f]] == C.trainClass[f] ? 1 : 0;
@@ -241,6 +263,10 @@ void cutAndMakePieces(const Surface& S, Classes& C, const Fabrication& fab, cons
             break;
         }
         // Split the pieces that do not fit into new classes and train again.
+        run.detail(std::to_string(tooLarge.size()) + " piece(s) do not fit the printer and " +
+                   std::to_string(unmountable.size()) +
+                   " no direction mounts after the planar cuts; split and retrain");
+        tooLarge.insert(tooLarge.end(), unmountable.begin(), unmountable.end());
         for (uint32_t p : tooLarge) {
             const uint32_t c =
                 newClassFor(S, res, C, pieceFaces[p]);  // the piece's faces get one class of their own first
@@ -251,8 +277,6 @@ void cutAndMakePieces(const Surface& S, Classes& C, const Fabrication& fab, cons
             if (!C.faceGroup.empty())
                 for (uint32_t f : pieceFaces[p]) C.faceGroup[f] = C.groupCount + C.trainClass[f];
         }
-        run.detail(std::to_string(tooLarge.size()) +
-                   " piece(s) do not fit the printer after the planar cuts; split and retrain");
     }
     res.secondsSvm = clock.seconds();
 }

@@ -4,7 +4,9 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "zomefab/core/error.h"
@@ -91,9 +93,21 @@ PartitionResult partitionSurface(const TriMesh& meshMm, const zome::Structure& f
     context.throwIfCancelled();
     FitTester fits{
         meshMm, surface.graph, fabrication, context, std::vector<uint32_t>(meshMm.positions.size(), 0), 0};
+    if (options.mountBlockedShare >= 0.0) {
+        // The wall's inside, where it first meets the frame: the wall's thickness behind the
+        // surface, but never deeper than the frame's nearest ball comes (a frame built for a
+        // thinner wall than the one asked of this stage).
+        double nearestBallMm = std::numeric_limits<double>::infinity();
+        for (size_t f = 0; f < surface.faceCount; ++f)
+            nearestBallMm = std::min(nearestBallMm, surface.near.distancesMm[f * size_t(surface.k)]);
+        const double innerMm = std::clamp(nearestBallMm - frame.scale().ballRadiusMm() - kMountMarginMm, 0.0,
+                                          fabrication.wallMm);
+        fits.blocked = frameBlockedDirections(meshMm, surface.graph, frame, innerMm, kMountMarginMm);
+        fits.blockedShare = options.mountBlockedShare;
+    }
     Classes classes;
     runSchedule(surface, problems, options, fits, classes, res, context);
-    mergeRegions(surface, fabrication, options, classes, res, context);
+    mergeRegions(surface, fits, options, classes, res, context);
     cutAndMakePieces(surface, classes, fabrication, options, fits, res, context);
     res.secondsTotal = total.seconds();
     context.progress("partition", 1.0);

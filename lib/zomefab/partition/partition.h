@@ -65,6 +65,10 @@ struct PartitionOptions {
     /// assembly effort, and small pieces rarely get tenons. The merged regions keep their own SVM
     /// classes (cells); a piece is then made of several cells. false: one piece per region.
     bool mergeSmallRegions = true;
+    /// A region must be mountable: along some hole direction its wall, pushed off, runs into the
+    /// frame over at most this share of its area (docs/partition.md §4, "Mountable"); the others
+    /// are cut again like regions too large for the printer. Negative: not tested (the paper).
+    double mountBlockedShare = 0.005;
 
     // --- saliency (§5.1, Eq. 4): union of the mesh's salientFaces flags and these ---------------
     std::vector<SalientSphere> salientSpheres;  ///< faces touching a sphere are salient
@@ -124,9 +128,14 @@ struct RegionMerge {
 /// @p marginMm (the schedule's fit test): the smallest region (by area, then id) that has a
 /// neighbour it fits with goes into the one of those with the longest shared seam (then lowest id);
 /// stops when no merge fits. Deterministic, whatever the thread count.
+/// With @p blockedDirections (per face, bit h: along hole h its wall runs into the frame;
+/// docs/partition.md §4, "Mountable"), a union must also leave some direction at most
+/// @p blockedShare of its area blocked.
 RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph,
                                 const std::vector<uint32_t>& regionOf, uint32_t regionCount,
-                                const Vec3d& printerMm, double marginMm);
+                                const Vec3d& printerMm, double marginMm,
+                                const std::vector<uint64_t>& blockedDirections = {},
+                                double blockedShare = 0.0);
 
 /// Per-face flags: the mesh's salientFaces, faces within a sphere (closest point of the triangle
 /// within the radius) and the listed indices. @throw Error(Usage) for an index out of range.

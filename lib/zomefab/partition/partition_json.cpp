@@ -51,6 +51,11 @@ json partitionToJson(const PartitionResult& r, const PartitionOptions& o, const 
         const Piece& piece = r.pieces[p];
         json axes =
             json::array({toJson(piece.fit.axes[0]), toJson(piece.fit.axes[1]), toJson(piece.fit.axes[2])});
+        json patches = json::array();
+        for (const Piece::CellPatch& c : piece.patches)
+            patches.push_back(
+                {{"cell", c.cell},
+                 {"bbox_mm", {{"min", toJson(c.boundsMm.min)}, {"max", toJson(c.boundsMm.max)}}}});
         pieces.push_back(
             {{"piece", p},
              {"cells", piece.cells},
@@ -58,6 +63,7 @@ json partitionToJson(const PartitionResult& r, const PartitionOptions& o, const 
              {"faces", piece.faceCount},
              {"area_mm2", piece.areaMm2},
              {"bbox_mm", {{"min", toJson(piece.boundsMm.min)}, {"max", toJson(piece.boundsMm.max)}}},
+             {"patches", std::move(patches)},
              {"fit",
               {{"fits", piece.fit.fits},
                {"ratio", piece.fit.ratio},

@@ -77,6 +77,24 @@ void readPieces(const json& pieces, PartitionResult& r) {
             piece.boundsMm.expand(vec3FromJson(b["max"], name + " bbox_mm.max"));
         }
         if (j.contains("fit")) piece.fit = fitFromJson(j["fit"], name + " fit");
+        if (j.contains("patches")) {
+            const json& list = j["patches"];
+            if (!list.is_array()) fail(name + ": patches must be a list");
+            for (size_t k = 0; k < list.size(); ++k) {
+                const std::string what = name + " patch " + std::to_string(k);
+                const json& c = list[k];
+                if (!c.is_object() || !c.contains("cell") || !c.contains("bbox_mm") ||
+                    !c["bbox_mm"].is_object() || !c["bbox_mm"].contains("min") ||
+                    !c["bbox_mm"].contains("max"))
+                    fail(what + ": needs cell and bbox_mm (min, max)");
+                Piece::CellPatch patch;
+                patch.cell = indexFromJson(c["cell"], what + " cell");
+                if (patch.cell >= r.cells.cellCount()) fail(what + ": cell does not exist");
+                patch.boundsMm.expand(vec3FromJson(c["bbox_mm"]["min"], what + " bbox_mm.min"));
+                patch.boundsMm.expand(vec3FromJson(c["bbox_mm"]["max"], what + " bbox_mm.max"));
+                piece.patches.push_back(patch);
+            }
+        }
         r.pieces.push_back(std::move(piece));
     }
 }

@@ -45,6 +45,15 @@ struct Piece {
     double areaMm2 = 0.0;
     Box3d boundsMm;  ///< axis-aligned box of its faces' vertices
     PrinterFit fit;  ///< best orientation in the printer
+    /// Its surface in each cell: one entry per connected part of its faces in one cell, with the
+    /// box of their vertices. A cell whose region crosses a thin object twice has surface in two
+    /// pieces; the pieces stage gives each part of the shell in that cell to the piece whose
+    /// patch in that cell it lies under.
+    struct CellPatch {
+        uint32_t cell = 0;
+        Box3d boundsMm;
+    };
+    std::vector<CellPatch> patches;
 };
 
 struct PartitionResult {

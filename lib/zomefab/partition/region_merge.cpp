@@ -31,15 +31,16 @@ double sharedEdgeMm(const TriMesh& mesh, uint32_t f, uint32_t h) {
 /// regions of one training class (after any bisection); merged regions keep their classes, so
 /// the SVM still sees each as it was cut, and form one group, which makePieces turns into one
 /// piece of several cells.
-void mergeRegions(const Surface& S, const Fabrication& fab, const PartitionOptions& opt, Classes& C,
+void mergeRegions(const Surface& S, const FitTester& fits, const PartitionOptions& opt, Classes& C,
                   PartitionResult& res, const RunContext& run) {
+    const Fabrication& fab = fits.fab;
     if (!opt.mergeSmallRegions) return;
     run.throwIfCancelled();
     const Stopwatch clock;
     std::vector<uint32_t> regionOf;
     const uint32_t regionCount = labelComponents(S.graph, C.trainClass, regionOf);
-    const RegionMerge m =
-        mergeRegionsThatFit(S.mesh, S.graph, regionOf, regionCount, fab.printerMm, fab.fitMarginMm);
+    const RegionMerge m = mergeRegionsThatFit(S.mesh, S.graph, regionOf, regionCount, fab.printerMm,
+                                              fab.fitMarginMm, fits.blocked, fits.blockedShare);
     C.faceGroup.resize(S.faceCount);
     for (uint32_t f = 0; f < S.faceCount; ++f) C.faceGroup[f] = m.groupOf[regionOf[f]];
     C.groupCount = m.groupCount;
@@ -56,7 +57,8 @@ using namespace detail;
 
 RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph,
                                 const std::vector<uint32_t>& regionOf, uint32_t regionCount,
-                                const Vec3d& printerMm, double marginMm) {
+                                const Vec3d& printerMm, double marginMm,
+                                const std::vector<uint64_t>& blockedDirections, double blockedShare) {
     const size_t faceCount = graph.faceCount();
     if (regionOf.size() != faceCount)
         throw Error(ErrorCode::Usage, "region merge: " + std::to_string(regionOf.size()) +
@@ -65,6 +67,7 @@ RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph,
     // a seam appears in both, which does not change a box), and the seam length to each neighbour.
     std::vector<double> area(regionCount, 0.0);
     std::vector<std::vector<Vec3d>> pts(regionCount);
+    std::vector<MountProfile> profile(blockedDirections.empty() ? 0 : regionCount);
     std::vector<std::map<uint32_t, double>> seam(regionCount);
     {
         std::vector<uint32_t> offsets, faces;
@@ -78,6 +81,8 @@ RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph,
     }
     for (uint32_t f = 0; f < faceCount; ++f) {
         area[regionOf[f]] += graph.areasMm2[f];
+        if (!profile.empty())
+            profile[regionOf[f]].addFace(graph.areasMm2[f], graph.normals[f], blockedDirections[f]);
         for (uint32_t i = graph.offsets[f]; i < graph.offsets[f + 1]; ++i) {
             const uint32_t h = graph.neighbors[i];
             if (regionOf[h] != regionOf[f]) seam[regionOf[f]][regionOf[h]] += sharedEdgeMm(meshMm, f, h);
@@ -107,6 +112,11 @@ RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph,
             // seam order that fits wins, so the choice does not depend on the threads.
             std::vector<char> isFit(byLength.size(), 0);
             tbb::parallel_for(size_t(0), byLength.size(), [&](size_t i) {
+                if (!profile.empty()) {
+                    MountProfile joined = profile[r];
+                    joined.add(profile[byLength[i].second]);
+                    if (!joined.isMountable(blockedShare)) return;  // no direction would mount it
+                }
                 std::vector<Vec3d> u(pts[r]);
                 const std::vector<Vec3d>& other = pts[byLength[i].second];
                 u.insert(u.end(), other.begin(), other.end());
@@ -128,6 +138,7 @@ RegionMerge mergeRegionsThatFit(const TriMesh& meshMm, const FaceGraph& graph,
             isRoot[gone] = 0;
             area[root] += area[gone];
             pts[root].insert(pts[root].end(), pts[gone].begin(), pts[gone].end());
+            if (!profile.empty()) profile[root].add(profile[gone]);
             std::vector<Vec3d>().swap(pts[gone]);
             for (const auto& [o, len] : seam[gone]) {
                 if (o == root) continue;

@@ -56,8 +56,9 @@ std::vector<char> fitsEach(FitTester& cx, const std::vector<std::vector<uint32_t
     std::vector<std::vector<Vec3d>> pts(n);
     for (size_t c = 0; c < n; ++c) pts[c] = faceVertices(cx.mesh, faceSets[c], cx.stamp, cx.stampValue);
     std::vector<char> fits(n, 1);
-    tbb::parallel_for(size_t(0), n,
-                      [&](size_t c) { fits[c] = fitsPrinter(pts[c], cx.fab.printerMm, cx.fab.fitMarginMm); });
+    tbb::parallel_for(size_t(0), n, [&](size_t c) {
+        fits[c] = cx.isMountable(faceSets[c]) && fitsPrinter(pts[c], cx.fab.printerMm, cx.fab.fitMarginMm);
+    });
     return fits;
 }
 
@@ -68,8 +69,19 @@ void bisectUntilFit(FitTester& cx, const std::vector<uint32_t>& faces,
                     const std::vector<uint32_t>& salientRegionOf, std::vector<std::vector<uint32_t>>& parts,
                     int depth) {
     const PrinterFit fit = cx.fitOf(faces);
-    if (fit.fits || depth > 16 || faces.size() < 2) {
+    if (depth > 16 || faces.size() < 2) {
         parts.push_back(faces);
+        return;
+    }
+    if (fit.fits) {
+        // It fits the printer; if no direction can mount it, cut off what its best one cannot take.
+        std::vector<uint32_t> lo, hi;
+        if (cx.isMountable(faces) || !splitUnmountable(cx, faces, lo, hi)) {
+            parts.push_back(faces);
+            return;
+        }
+        bisectUntilFit(cx, lo, salientRegionOf, parts, depth + 1);
+        bisectUntilFit(cx, hi, salientRegionOf, parts, depth + 1);
         return;
     }
     const Vec3d& axis = fit.axes[2];  // the longest box axis

@@ -259,20 +259,30 @@ void describePieces(Grouping& out, const std::vector<Component>& comps,
 
 FaceContacts faceContacts(const VoxelField& field, const GridCells& cells, const std::vector<CellSet>& sets,
                           std::vector<Piece>& pieces) {
-    // Voxel faces per (lower piece, higher piece, lower's cell, higher's cell); a pair in one cell
-    // is a re-cut face (its plane is one of the pieces' half-spaces).
-    std::map<std::tuple<uint32_t, uint32_t, uint32_t, uint32_t>, size_t> counts;
+    // Voxel faces per (lower piece, higher piece, lower's cell, higher's cell); a pair in one cell,
+    // or in two cells both pieces have, is a re-cut face (its plane is one of their half-spaces).
+    // With each, the sum of the unit steps from the lower piece's voxel to the higher's: where no
+    // plane separates the two (pieces that share a cell), its direction is the face's mean normal.
+    std::map<std::tuple<uint32_t, uint32_t, uint32_t, uint32_t>, std::pair<size_t, Vec3d>> counts;
     forEachForwardPair(field, [&](size_t a, size_t b) {
         if (!field.isInside(a) || !field.isInside(b) || field.owner[a] == field.owner[b]) return;
-        if (field.owner[a] > field.owner[b]) std::swap(a, b);
-        ++counts[{field.owner[a], field.owner[b], field.cell[a], field.cell[b]}];
+        const Vec3d step = sub(field.world(field.coordOf(b)), field.world(field.coordOf(a)));
+        const bool isSwapped = field.owner[a] > field.owner[b];
+        if (isSwapped) std::swap(a, b);
+        auto& entry = counts[{field.owner[a], field.owner[b], field.cell[a], field.cell[b]}];
+        ++entry.first;
+        entry.second = madd(entry.second, isSwapped ? -1.0 : 1.0, step);
     });
     FaceContacts faces;
     std::map<std::pair<uint32_t, uint32_t>, size_t> total;
-    for (const auto& [key, count] : counts) {
+    for (const auto& [key, entry] : counts) {
         const auto [pa, pb, ca, cb] = key;
+        const size_t count = entry.first;
         Vec3d normal{0, 0, 0};
-        if (ca != cb) {
+        // Two cells of one piece's region are not cut from each other: where each piece has both
+        // cells, the pair lies across a plane they were re-cut along.
+        const bool isCellPlane = ca != cb && !(sets[pa].isMember[cb] && sets[pb].isMember[ca]);
+        if (isCellPlane) {
             normal = normalized(sub(cells.w[cb], cells.w[ca]));  // the plane s_ca = s_cb, into cb
         } else {
             // The plane a was re-cut along that b lies beyond (b's side of it).
@@ -282,6 +292,8 @@ FaceContacts faceContacts(const VoxelField& field, const GridCells& cells, const
                 for (const CellSet::HalfSpace& g : theirs)
                     if (dot(h.normal, g.normal) < -0.999999 && std::abs(h.offsetMm + g.offsetMm) < 1e-6)
                         normal = h.normal;
+            // No plane: the border between two pieces in one cell follows the voxels.
+            if (norm(normal) == 0.0 && norm(entry.second) > 0.0) normal = normalized(entry.second);
         }
         if (norm(normal) == 0.0) continue;
         auto& list = faces[{pa, pb}];
@@ -362,20 +374,26 @@ double assignGroups(std::vector<Component>& comps, const VoxelField& field,
         }
     }
     if (!needsVotes) return orphanVolume;
-    // A cell shared by several requests: each component goes to the request whose surface box
-    // (grown by the wall's thickness) holds most of its voxels.
+    // A cell shared by several requests: each component goes to the request whose surface in that
+    // cell (its patches, else its whole surface's box), grown by the wall's thickness, holds most
+    // of its voxels.
+    auto isNear = [&](const Box3d& box, const Vec3d& x) {
+        if (box.isEmpty()) return false;
+        for (int a = 0; a < 3; ++a)
+            if (x[size_t(a)] < box.min[size_t(a)] - grow || x[size_t(a)] > box.max[size_t(a)] + grow)
+                return false;
+        return true;
+    };
     for (size_t s = 0; s < field.phi.size(); ++s) {
         if (!field.isInside(s) || votes[field.owner[s]].empty()) continue;
         const uint32_t c = field.owner[s];
         const Vec3d x = gridToFrame.apply(field.world(field.coordOf(s)));
         const auto& reqs = cellRequests[comps[c].cell];
         for (size_t i = 0; i < reqs.size(); ++i) {
-            const Box3d& box = requests[reqs[i]].boundsMm;
-            if (box.isEmpty()) continue;
-            bool isIn = true;
-            for (int a = 0; a < 3; ++a)
-                if (x[size_t(a)] < box.min[size_t(a)] - grow || x[size_t(a)] > box.max[size_t(a)] + grow)
-                    isIn = false;
+            const partition::Piece& r = requests[reqs[i]];
+            bool isIn = r.patches.empty() && isNear(r.boundsMm, x);
+            for (const partition::Piece::CellPatch& p : r.patches)
+                isIn = isIn || (p.cell == comps[c].cell && isNear(p.boundsMm, x));
             if (isIn) ++votes[c][i];
         }
     }

@@ -6,6 +6,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <map>
+#include <tuple>
 
 #include "zomefab/core/format.h"
 #include "zomefab/zome/holes.h"
@@ -15,10 +17,6 @@ namespace zomefab::pieces::detail {
 namespace {
 
 constexpr uint32_t kStrutBit = 0x80000000u;
-
-Vec3d gridDirection(int hole, const Transform4d& frameToGridMm) {
-    return normalized(applyLinear(frameToGridMm, zome::holeDirection(hole)));
-}
 
 /// The rearmost point of a voxel's cube along @p d, relative to its centre.
 double halfDepth(const Vec3d& d, double voxelMm) {
@@ -96,12 +94,23 @@ PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
     // A body pushed along d first meets things with its rearmost points, which lie on its surface:
     // the inside voxels with a 6-neighbour outside the wall or in another piece are enough.
     std::vector<uint8_t> isSurface(field.phi.size(), 0), nearCut(field.phi.size(), 0);
+    // Voxel faces per cut face (as faceContacts counts them): only faces large enough to order
+    // their pieces by their plane leave their voxels out of the sweeps between neighbours.
+    auto faceKey = [&](size_t a, size_t b) {
+        if (field.owner[a] > field.owner[b]) std::swap(a, b);
+        return std::make_tuple(field.owner[a], field.owner[b], field.cell[a], field.cell[b]);
+    };
+    std::map<std::tuple<uint32_t, uint32_t, uint32_t, uint32_t>, size_t> faceSize;
+    forEachForwardPair(field, [&](size_t a, size_t b) {
+        if (field.isInside(a) && field.isInside(b) && field.owner[a] != field.owner[b])
+            ++faceSize[faceKey(a, b)];
+    });
     forEachForwardPair(field, [&](size_t a, size_t b) {
         const bool ia = field.isInside(a), ib = field.isInside(b);
         const bool isCut = ia && ib && field.owner[a] != field.owner[b];
         if (ia && (!ib || isCut)) isSurface[a] = 1;
         if (ib && (!ia || isCut)) isSurface[b] = 1;
-        if (isCut) nearCut[a] = nearCut[b] = 2;
+        if (isCut && faceSize[faceKey(a, b)] >= kMinOrderFaceVoxels) nearCut[a] = nearCut[b] = 2;
     });
     // One more layer inward from the cut faces (6-neighbours in the same piece).
     forEachForwardPair(field, [&](size_t a, size_t b) {
@@ -143,16 +152,21 @@ std::vector<DirectionOption> rankedOptions(const std::map<int, std::pair<size_t,
     return options;
 }
 
-void testPaths(MountBody& body, const FrameSweeps& sweeps, double voxelMm, bool isFirstFreeOnly) {
+Vec3d gridDirection(int hole, const Transform4d& frameToGridMm) {
+    return normalized(applyLinear(frameToGridMm, zome::holeDirection(hole)));
+}
+
+void testPaths(MountBody& body, const FrameSweeps& sweeps, double voxelMm, size_t freeWanted) {
     auto test = [&](DirectionOption& o) {
         if (o.isTested) return;
         o.isFree = sweeps.isFree(body, o.hole, voxelMm, &o.blockedBy);
         o.isTested = true;
     };
-    if (isFirstFreeOnly) {
+    if (freeWanted > 0) {
+        size_t free = 0;
         for (DirectionOption& o : body.options) {
             test(o);
-            if (o.isFree) return;
+            if (o.isFree && ++free == freeWanted) return;
         }
         return;
     }
@@ -160,8 +174,19 @@ void testPaths(MountBody& body, const FrameSweeps& sweeps, double voxelMm, bool 
     tbb::parallel_for(size_t(0), body.options.size(), [&](size_t i) { test(body.options[i]); });
 }
 
+void addGlueOptions(MountBody& body, const std::vector<int>& holes, const FrameSweeps& sweeps,
+                    double voxelMm) {
+    body.glueOptions.clear();
+    for (int hole : holes) body.glueOptions.push_back({hole, 0, 0.0, false, false, {}});
+    tbb::parallel_for(size_t(0), body.glueOptions.size(), [&](size_t i) {
+        DirectionOption& o = body.glueOptions[i];
+        o.isFree = sweeps.isFree(body, o.hole, voxelMm, &o.blockedBy);
+        o.isTested = true;
+    });
+}
+
 MountBody makeBody(const std::vector<uint32_t>& members, const PlannerInput& input, const FrameSweeps& sweeps,
-                   double voxelMm, int maxPerPiece, bool isFirstFreeOnly) {
+                   double voxelMm, int maxPerPiece, size_t freeWanted) {
     MountBody body;
     body.pieces = members;
     std::sort(body.pieces.begin(), body.pieces.end());
@@ -177,7 +202,7 @@ MountBody makeBody(const std::vector<uint32_t>& members, const PlannerInput& inp
         }
     }
     body.options = rankedOptions(byHole, size_t(std::max(1, maxPerPiece)) * body.pieces.size());
-    testPaths(body, sweeps, voxelMm, isFirstFreeOnly);
+    testPaths(body, sweeps, voxelMm, freeWanted);
     return body;
 }
 

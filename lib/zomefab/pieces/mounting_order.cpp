@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Who goes on first: the blocking relation between bodies for given directions, the choice of
-// directions that lets an order exist, and the glued bodies where none does (detail/mounting.h,
-// docs/mounting.md, "Order" and "Glued groups").
+// Who goes on first: whether a body can go on after another along a direction, the disassembly
+// that finds the mounting order and each body's direction, and the glued bodies where none exists
+// (detail/mounting.h, docs/mounting.md, "Order" and "Glued groups").
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <optional>
 #include <set>
@@ -15,9 +17,9 @@ namespace zomefab::pieces::detail {
 
 namespace {
 
-Vec3d gridDirection(int hole, const Transform4d& frameToGridMm) {
-    return normalized(applyLinear(frameToGridMm, zome::holeDirection(hole)));
-}
+/// A glued group has at most this many pieces: a maker glues a few pieces together, not half the
+/// object (what more gluing would resolve is re-cut instead).
+constexpr size_t kMaxGluedPieces = 4;
 
 /// Could the boxes meet when @p moving is pushed off along @p d past @p still? Their shadows on
 /// the plane normal to d overlap, and something of @p still lies ahead of @p moving's rear.
@@ -42,7 +44,7 @@ bool shadowsMeet(const Box3d& moving, const Box3d& still, const Vec3d& d) {
 
 /// Does @p moving, pushed off along @p d, run into @p still's voxels? A voxel of tolerance: two
 /// neighbours' voxels across their cut face are a voxel apart (the face itself is tested exactly
-/// by facesOrder).
+/// by facesAllow).
 bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, double voxelMm,
                bool isTouching) {
     if (!shadowsMeet(moving.bounds, still.bounds, d)) return false;
@@ -51,7 +53,7 @@ bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, 
     const mount::SweepAxes axes(d);
     mount::DepthRaster obstacle(axes, bounds, voxelMm, true, voxelMm),
         body(axes, bounds, voxelMm, false, voxelMm);
-    // Neighbours: the voxels along their cut faces are left to facesOrder (seen along a face nearly
+    // Neighbours: the voxels along their cut faces are left to facesAllow (seen along a face nearly
     // parallel to d, the voxels on its two sides would seem to lie ahead of each other).
     for (size_t i = 0; i < still.voxels.size(); ++i)
         if (!isTouching || !still.isNearCut[i])
@@ -61,26 +63,26 @@ bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, 
     return mount::worstHit(obstacle, body, voxelMm).isHit;
 }
 
-/// The order the cut faces between bodies @p a and @p b allow for their directions; isBAfterAOk
-/// and isAAfterBOk both true when they share no face.
-mount::FaceOrder facesOrder(const MountBody& a, const MountBody& b, const FaceContacts& faces,
-                            const Vec3d& da, const Vec3d& db, bool* isTouching) {
-    mount::FaceOrder all;
+/// Whether the cut faces between @p still and @p moving let @p moving go on after @p still along
+/// @p d (mount::faceOrder for every plane they share: its path does not go into still). True when
+/// they share no face; @p isTouching says whether they do.
+bool facesAllow(const MountBody& still, const MountBody& moving, const Vec3d& d, const FaceContacts& faces,
+                bool* isTouching) {
+    bool isOk = true;
     *isTouching = false;
-    for (uint32_t x : a.pieces)
-        for (uint32_t y : b.pieces) {
+    for (uint32_t x : still.pieces)
+        for (uint32_t y : moving.pieces) {
             const auto it = faces.find({std::min(x, y), std::max(x, y)});
             if (it == faces.end()) continue;
             *isTouching = true;
             for (const CutContact& c : it->second) {
-                // From the lower piece into the higher; flipped when a's piece is the higher.
+                if (c.voxelFaces < kMinOrderFaceVoxels) continue;  // in the sweeps (plannerInput)
+                // The stored normal points from the lower piece into the higher: here, into moving.
                 const Vec3d n = x < y ? c.normal : scale(c.normal, -1.0);
-                const mount::FaceOrder f = mount::faceOrder(n, da, db);
-                all.isBAfterAOk = all.isBAfterAOk && f.isBAfterAOk;
-                all.isAAfterBOk = all.isAAfterBOk && f.isAAfterBOk;
+                isOk = isOk && mount::faceOrder(n, d, d).isBAfterAOk;
             }
         }
-    return all;
+    return isOk;
 }
 
 /// The body names and a list of pieces for messages: "piece 3", "pieces 3 + 4 (glued)".
@@ -89,63 +91,6 @@ std::string bodyName(const MountBody& b) {
     std::string list;
     for (uint32_t p : b.pieces) list += (list.empty() ? "" : " + ") + std::to_string(p);
     return "pieces " + list + " (glued)";
-}
-
-std::vector<int> chosenHoles(const std::vector<MountBody>& bodies) {
-    std::vector<int> holes(bodies.size(), -1);
-    for (size_t b = 0; b < bodies.size(); ++b)
-        if (const DirectionOption* o = bodies[b].bestFree()) holes[b] = o->hole;
-    return holes;
-}
-
-/// Bottom first: the lowest point of each body.
-std::vector<double> priorities(const std::vector<MountBody>& bodies) {
-    std::vector<double> p;
-    for (const MountBody& b : bodies) p.push_back(b.bounds.min[2]);
-    return p;
-}
-
-/// Changes one body's direction at a time until the relation has an order: among the bodies in
-/// trouble and their free directions with tenons, the change that leaves the least trouble (ties:
-/// more tenons, then the lower body and rank); changes that leave as much trouble as before are
-/// taken too (a plateau), but never back to a direction the body had in the last rounds.
-/// Returns the least trouble seen; @p holes holds its directions.
-Trouble improveDirections(const std::vector<MountBody>& bodies, std::vector<int>& holes,
-                          const FaceContacts& faces, const Transform4d& frameToGridMm, double voxelMm,
-                          SweepCache& cache, const RunContext& context) {
-    Trouble trouble = blockingTrouble(bodies, holes, faces, frameToGridMm, voxelMm, cache);
-    Trouble best = trouble;
-    std::vector<int> bestHoles = holes;
-    std::vector<std::pair<uint32_t, int>> recent;  // (body, hole) it left: tabu for a while
-    const size_t tabu = 2 * bodies.size() + 2;
-    for (size_t round = 0; best.count() > 0 && round < 8 * bodies.size() + 16; ++round) {
-        context.throwIfCancelled();
-        std::set<uint32_t> involved(trouble.cycle.begin(), trouble.cycle.end());
-        for (const auto& [a, b] : trouble.deadlocks) involved.insert(a), involved.insert(b);
-        std::optional<std::tuple<size_t, size_t, uint32_t, size_t>> choice;  // (trouble, −tenons, body, rank)
-        Trouble chosen;
-        for (uint32_t b : involved)
-            for (size_t rank = 0; rank < bodies[b].options.size(); ++rank) {
-                const DirectionOption& o = bodies[b].options[rank];
-                if (!o.isFree || o.tenons == 0 || o.hole == holes[b]) continue;
-                if (std::find(recent.begin(), recent.end(), std::make_pair(b, o.hole)) != recent.end())
-                    continue;
-                std::vector<int> trial = holes;
-                trial[b] = o.hole;
-                Trouble t = blockingTrouble(bodies, trial, faces, frameToGridMm, voxelMm, cache);
-                const auto key = std::make_tuple(t.count(), size_t(1000000) - o.tenons, b, rank);
-                if (!choice || key < *choice) choice = key, chosen = std::move(t);
-            }
-        if (!choice || std::get<0>(*choice) > trouble.count()) break;  // only worse moves left
-        const uint32_t b = std::get<2>(*choice);
-        recent.push_back({b, holes[b]});
-        if (recent.size() > tabu) recent.erase(recent.begin());
-        holes[b] = bodies[b].options[std::get<3>(*choice)].hole;
-        trouble = std::move(chosen);
-        if (trouble.count() < best.count()) best = trouble, bestHoles = holes;
-    }
-    holes = bestHoles;
-    return best;
 }
 
 /// The pair of pieces, one of each body, with the largest common cut face: where they are glued.
@@ -177,86 +122,37 @@ struct Bodies {
     }
 };
 
-/// Tenons of a body along its best free direction (0 when it has none).
-size_t heldBy(const MountBody& b) {
-    const DirectionOption* o = b.bestFree();
-    return o ? o->tenons : 0;
-}
-
-/// The best union of body @p i with a neighbour: the one with the most tenons along a free
-/// direction, then the largest contact, then the lowest index; at least @p minTenons of them.
-/// SIZE_MAX when there is none.
-size_t bestPartner(const Bodies& bodies, size_t i, size_t minTenons, const PlannerInput& input,
-                   const FrameSweeps& sweeps, const FaceContacts& faces, double voxelMm, int maxPerPiece,
-                   MountBody* joined) {
-    size_t best = SIZE_MAX;
-    std::tuple<size_t, double, size_t> bestKey{0, 0.0, 0};
-    for (size_t j = 0; j < bodies.list.size(); ++j) {
-        if (j == i) continue;
-        const size_t contact = bodyContact(bodies.list[i], bodies.list[j], faces);
-        if (contact == 0) continue;
-        std::vector<uint32_t> members = bodies.list[i].pieces;
-        members.insert(members.end(), bodies.list[j].pieces.begin(), bodies.list[j].pieces.end());
-        MountBody u = makeBody(members, input, sweeps, voxelMm, maxPerPiece, true);
-        const DirectionOption* o = u.bestFree();
-        if (!o || o->tenons < minTenons) continue;
-        const std::tuple<size_t, double, size_t> key{o->tenons, o->score, contact};
-        if (best == SIZE_MAX || key > bestKey) best = j, bestKey = key, *joined = std::move(u);
-    }
-    return best;
-}
-
-/// Glues every body held by fewer than @p minTenons tenons to the partner that gives their union
-/// the most (at least @p minTenons and more than the body had), as long as one does.
-void glueWeak(Bodies& bodies, size_t minTenons, const PlannerInput& input, const FrameSweeps& sweeps,
-              const FaceContacts& faces, double voxelMm, int maxPerPiece, const RunContext& context) {
-    std::set<uint32_t> hopeless;  // by first piece: no partner helps them
-    for (bool isChanged = true; isChanged;) {
-        isChanged = false;
-        for (size_t i = 0; i < bodies.list.size(); ++i) {
-            const size_t own = heldBy(bodies.list[i]);
-            if (own >= minTenons || hopeless.count(bodies.list[i].pieces[0])) continue;
-            context.throwIfCancelled();
-            MountBody joined;
-            const size_t j = bestPartner(bodies, i, std::max(minTenons, own + 1), input, sweeps, faces,
-                                         voxelMm, maxPerPiece, &joined);
-            if (j == SIZE_MAX) {
-                hopeless.insert(bodies.list[i].pieces[0]);
-                continue;
+/// Glues one pair of touching bodies, one of them stuck, whose union has a free direction with
+/// tenons: two stuck ones in each other's way first, then two stuck ones, then a stuck one and a
+/// neighbour (a piece to be glued on that its only host is in the way of), each by the largest
+/// contact. False when there is none.
+bool glueStuck(Bodies& bodies, const Disassembly& parts, const PlannerInput& input, const FrameSweeps& sweeps,
+               const FaceContacts& faces, double voxelMm, int maxPerPiece) {
+    auto blocks = [&](size_t k, uint32_t other) {
+        const std::vector<uint32_t>& list = parts.stuckBlockers[k];
+        return std::find(list.begin(), list.end(), other) != list.end();
+    };
+    std::vector<std::tuple<int, size_t, uint32_t, uint32_t>> pairs;  // (−kind, −contact, a, b)
+    for (size_t i = 0; i < parts.stuck.size(); ++i)
+        for (uint32_t b = 0; b < bodies.list.size(); ++b) {
+            const uint32_t a = parts.stuck[i];
+            const auto other = std::find(parts.stuck.begin(), parts.stuck.end(), b);
+            if (b == a || (other != parts.stuck.end() && b < a)) continue;  // each stuck pair once
+            const size_t contact = bodyContact(bodies.list[a], bodies.list[b], faces);
+            if (contact == 0) continue;
+            int kind = 0;
+            if (other != parts.stuck.end()) {
+                const size_t j = size_t(other - parts.stuck.begin());
+                kind = 1 + (blocks(i, b) ? 1 : 0) + (blocks(j, a) ? 1 : 0);
             }
-            context.debug("mounting: " + bodyName(bodies.list[i]) + " (" + std::to_string(own) +
-                          " tenons) glued to " + bodyName(bodies.list[j]) + ": " +
-                          std::to_string(heldBy(joined)) + " tenons");
-            testPaths(joined, sweeps, voxelMm);
-            bodies.glue(i, j, std::move(joined), faces);
-            hopeless.clear();  // the bodies changed: a partner may exist now
-            isChanged = true;
-            break;
+            pairs.push_back({-kind, size_t(0) - contact, a, b});
         }
-    }
-    for (const MountBody& b : bodies.list) {
-        if (heldBy(b) >= minTenons) continue;
-        std::string options;
-        for (const DirectionOption& o : b.options)
-            options += " " + std::to_string(o.hole) + ":" + std::to_string(o.tenons) +
-                       (o.isFree ? "" : "(" + o.blockedBy + ")");
-        context.debug("mounting: " + bodyName(b) + " held by " + std::to_string(heldBy(b)) +
-                      " tenons; options" + options);
-    }
-}
-
-/// Glues one pair of bodies that keeps the relation from an order (a deadlocked pair, else two
-/// neighbours of the cycle) when their union is held. False when no such pair can be glued.
-bool glueTrouble(Bodies& bodies, const Trouble& trouble, const PlannerInput& input, const FrameSweeps& sweeps,
-                 const FaceContacts& faces, double voxelMm, int maxPerPiece) {
-    std::vector<std::pair<uint32_t, uint32_t>> pairs = trouble.deadlocks;
-    for (size_t k = 0; k < trouble.cycle.size(); ++k)
-        pairs.push_back({trouble.cycle[k], trouble.cycle[(k + 1) % trouble.cycle.size()]});
-    for (const auto& [a, b] : pairs) {
-        if (a == b || bodyContact(bodies.list[a], bodies.list[b], faces) == 0) continue;
+    std::sort(pairs.begin(), pairs.end());
+    for (const auto& [mutual, contact, a, b] : pairs) {
+        if (bodies.list[a].pieces.size() + bodies.list[b].pieces.size() > kMaxGluedPieces) continue;
         std::vector<uint32_t> members = bodies.list[a].pieces;
         members.insert(members.end(), bodies.list[b].pieces.begin(), bodies.list[b].pieces.end());
-        MountBody u = makeBody(members, input, sweeps, voxelMm, maxPerPiece, true);
+        MountBody u = makeBody(members, input, sweeps, voxelMm, maxPerPiece, 1);
         if (!u.bestFree()) continue;
         testPaths(u, sweeps, voxelMm);
         bodies.glue(a, b, std::move(u), faces);
@@ -265,8 +161,7 @@ bool glueTrouble(Bodies& bodies, const Trouble& trouble, const PlannerInput& inp
     return false;
 }
 
-mount::InstallationPlan writePlan(const Bodies& bodies, const std::vector<int>& holes, const Trouble& trouble,
-                                  size_t pieceCount) {
+mount::InstallationPlan writePlan(const Bodies& bodies, const Disassembly& parts, size_t pieceCount) {
     mount::InstallationPlan plan;
     plan.holeOfPiece.assign(pieceCount, -1);
     plan.groupOf.assign(pieceCount, 0);
@@ -274,28 +169,47 @@ mount::InstallationPlan writePlan(const Bodies& bodies, const std::vector<int>& 
     std::sort(plan.glued.begin(), plan.glued.end());
     for (size_t b = 0; b < bodies.list.size(); ++b)
         for (uint32_t p : bodies.list[b].pieces) {
-            plan.holeOfPiece[p] = holes[b];
+            plan.holeOfPiece[p] = parts.holes[b];
             plan.groupOf[p] = bodies.list[b].pieces[0];
         }
-    for (const auto& [a, b] : trouble.before)
+    for (const auto& [a, b] : parts.before)
         plan.before.push_back({bodies.list[a].pieces[0], bodies.list[b].pieces[0]});
+    plan.gluedOn = parts.gluedOn;
     for (size_t b = 0; b < bodies.list.size(); ++b) {
-        if (holes[b] >= 0) continue;
         const MountBody& body = bodies.list[b];
+        if (parts.holes[b] >= 0 || std::count(parts.stuck.begin(), parts.stuck.end(), uint32_t(b))) continue;
         std::string why = body.options.empty() ? "no ball's hole points at it within a tenon's reach"
                                                : "every direction with tenons is blocked (" +
                                                      body.options[0].blockedBy + " in the way of the best)";
+        const bool isFreeAlong = std::any_of(body.glueOptions.begin(), body.glueOptions.end(),
+                                             [](const DirectionOption& o) { return o.isFree; });
+        why += isFreeAlong ? ", and it shares no cut face large enough to glue it onto a neighbour"
+                           : ", and the frame is in the way of every direction to glue it on along";
         plan.problems.push_back(bodyName(body) + ": no direction to push it on along and hold it: " + why);
     }
-    for (const auto& [a, b] : trouble.deadlocks)
-        plan.problems.push_back(bodyName(bodies.list[a]) + " and " + bodyName(bodies.list[b]) +
-                                " block each other: each would have to go on before the other");
-    if (trouble.deadlocks.empty() && !trouble.cycle.empty()) {
-        std::string list;
-        for (uint32_t b : trouble.cycle) list += (list.empty() ? "" : ", ") + bodyName(bodies.list[b]);
-        plan.problems.push_back(list + " block each other in a cycle");
+    if (!parts.stuck.empty()) {
+        std::string list, detail;
+        for (size_t k = 0; k < parts.stuck.size(); ++k) {
+            const uint32_t b = parts.stuck[k];
+            list += (k == 0 ? "" : k + 1 == parts.stuck.size() ? " and " : ", ") + bodyName(bodies.list[b]);
+            if (k >= 3) continue;
+            if (parts.stuckBlockers[k].empty()) {
+                detail += (detail.empty() ? "" : "; ") + bodyName(bodies.list[b]) +
+                          ": no piece to glue it onto is on when its path is free";
+                continue;
+            }
+            std::string in;
+            for (uint32_t o : parts.stuckBlockers[k])
+                in += (in.empty() ? "" : ", ") + bodyName(bodies.list[o]);
+            detail +=
+                (detail.empty() ? "" : "; ") + bodyName(bodies.list[b]) + " along its best direction: " + in;
+        }
+        plan.problems.push_back(
+            list + " cannot be put on in any order: each one's path or cut faces meet another of them (" +
+            detail + ")");
     }
-    for (uint32_t b : trouble.order) plan.steps.push_back({bodies.list[b].pieces, holes[b]});
+    if (parts.stuck.empty())
+        for (uint32_t b : parts.order) plan.steps.push_back({bodies.list[b].pieces, parts.holes[b]});
     return plan;
 }
 
@@ -312,62 +226,239 @@ size_t bodyContact(const MountBody& a, const MountBody& b, const FaceContacts& f
     return count;
 }
 
-Trouble blockingTrouble(const std::vector<MountBody>& bodies, const std::vector<int>& holes,
-                        const FaceContacts& faces, const Transform4d& frameToGridMm, double voxelMm,
-                        SweepCache& cache) {
-    Trouble t;
+namespace {
+
+/// One usable direction of a body: an index into its options (held by tenons) or into its glue
+/// options (glued onto a body already in place).
+struct Usable {
+    size_t option = 0;
+    bool isGlue = false;
+};
+
+/// One body's usable directions (free, with tenons, in rank order; then its free glue options) and,
+/// once asked for, the bodies in the way of each.
+struct BodyState {
+    std::vector<Usable> usable;
+    std::vector<std::optional<std::vector<uint32_t>>> blockers;
+    bool canGlue() const { return !usable.empty() && usable.back().isGlue; }
+};
+
+int holeOf(const std::vector<MountBody>& bodies, const std::vector<BodyState>& state, uint32_t b, size_t k) {
+    const Usable& u = state[b].usable[k];
+    return (u.isGlue ? bodies[b].glueOptions : bodies[b].options)[u.option].hole;
+}
+
+/// The usable directions of @p body: its free options with tenons, then (when it has faces to be
+/// glued on across) its free glue options.
+std::vector<Usable> usableOf(const MountBody& body, bool hasHosts) {
+    std::vector<Usable> list;
+    for (size_t i = 0; i < body.options.size(); ++i) {
+        const DirectionOption& o = body.options[i];
+        if (o.isTested && o.isFree && o.tenons > 0) list.push_back({i, false});
+    }
+    if (hasHosts)
+        for (size_t i = 0; i < body.glueOptions.size(); ++i)
+            if (body.glueOptions[i].isTested && body.glueOptions[i].isFree) list.push_back({i, true});
+    return list;
+}
+
+/// The bodies that keep @p b from going on after them along usable direction @p k (computed once;
+/// the sweeps in parallel).
+const std::vector<uint32_t>& blockersOf(std::vector<BodyState>& state, uint32_t b, size_t k,
+                                        const std::vector<MountBody>& bodies, const FaceContacts& faces,
+                                        const Transform4d& frameToGridMm, double voxelMm, SweepCache& cache) {
+    std::optional<std::vector<uint32_t>>& slot = state[b].blockers[k];
+    if (slot) return *slot;
+    const int hole = holeOf(bodies, state, b, k);
+    const Vec3d d = gridDirection(hole, frameToGridMm);
     const size_t n = bodies.size();
-    for (uint32_t a = 0; a < n; ++a)
-        for (uint32_t b = a + 1; b < n; ++b) {
-            if (holes[a] < 0 || holes[b] < 0) continue;
-            const Vec3d da = gridDirection(holes[a], frameToGridMm),
-                        db = gridDirection(holes[b], frameToGridMm);
-            // Neighbours by their cut faces (a shallow crossing of a face), and every pair by a sweep
-            // (a neighbour may also lie across the path farther on: a piece that wraps around).
-            bool isTouching = false;
-            mount::FaceOrder order = facesOrder(bodies[a], bodies[b], faces, da, db, &isTouching);
-            auto hits = [&](uint32_t moving, uint32_t still, int hole, const Vec3d& d) {
-                const auto key = std::make_tuple(bodies[moving].pieces, bodies[still].pieces, hole);
-                const auto it = cache.find(key);
-                if (it != cache.end()) return it->second;
-                return cache[key] = sweepHits(bodies[moving], bodies[still], d, voxelMm, isTouching);
-            };
-            order.isBAfterAOk = order.isBAfterAOk && !hits(b, a, holes[b], db);
-            order.isAAfterBOk = order.isAAfterBOk && !hits(a, b, holes[a], da);
-            if (order.isBAfterAOk && order.isAAfterBOk) continue;
-            if (order.isBAfterAOk)
-                t.before.push_back({a, b});
-            else if (order.isAAfterBOk)
-                t.before.push_back({b, a});
-            else
-                t.deadlocks.push_back({a, b});
+    // Faces and cached sweeps first; the sweeps still to make run in parallel.
+    std::vector<int8_t> isBlocked(n, 0);
+    std::vector<uint32_t> toSweep;
+    std::vector<uint8_t> touching(n, 0);
+    for (uint32_t a = 0; a < n; ++a) {
+        if (a == b || state[a].usable.empty()) continue;
+        bool isTouching = false;
+        if (!facesAllow(bodies[a], bodies[b], d, faces, &isTouching)) {
+            isBlocked[a] = 1;
+            continue;
         }
-    if (t.deadlocks.empty()) t.order = mount::mountingOrder(n, t.before, priorities(bodies), &t.cycle);
-    return t;
+        touching[a] = isTouching;
+        const auto it = cache.find(std::make_tuple(bodies[b].pieces, bodies[a].pieces, hole));
+        if (it != cache.end())
+            isBlocked[a] = it->second;
+        else
+            toSweep.push_back(a);
+    }
+    std::vector<uint8_t> hits(toSweep.size(), 0);
+    tbb::parallel_for(size_t(0), toSweep.size(), [&](size_t i) {
+        hits[i] = sweepHits(bodies[b], bodies[toSweep[i]], d, voxelMm, touching[toSweep[i]]);
+    });
+    for (size_t i = 0; i < toSweep.size(); ++i) {
+        cache[std::make_tuple(bodies[b].pieces, bodies[toSweep[i]].pieces, hole)] = hits[i];
+        isBlocked[toSweep[i]] = int8_t(hits[i]);
+    }
+    slot.emplace();
+    for (uint32_t a = 0; a < n; ++a)
+        if (isBlocked[a]) slot->push_back(a);
+    return *slot;
+}
+
+/// A cut face a hosted body could be glued on across: host body, host piece, the hosted body's
+/// piece, the face's normal into the hosted piece.
+struct HostFace {
+    uint32_t body, hostPiece, piece;
+    Vec3d normal;
+};
+
+/// The faces between hosted body @p b and the other bodies large enough to glue on.
+std::vector<HostFace> hostFaces(const std::vector<MountBody>& bodies, uint32_t b, const FaceContacts& faces,
+                                double voxelMm, const GlueOnRule& rule) {
+    std::vector<HostFace> out;
+    for (uint32_t a = 0; a < bodies.size(); ++a) {
+        if (a == b) continue;
+        for (uint32_t x : bodies[a].pieces)
+            for (uint32_t y : bodies[b].pieces) {
+                const auto it = faces.find({std::min(x, y), std::max(x, y)});
+                if (it == faces.end()) continue;
+                for (const CutContact& c : it->second)
+                    if (double(c.voxelFaces) * voxelMm * voxelMm >= rule.minFaceMm2)
+                        out.push_back({a, x, y, x < y ? c.normal : scale(c.normal, -1.0)});
+            }
+    }
+    return out;
+}
+
+}  // namespace
+
+Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts& faces,
+                        const Transform4d& frameToGridMm, double voxelMm, const GlueOnRule& glueOn,
+                        SweepCache& cache, const RunContext& context) {
+    const size_t n = bodies.size();
+    std::vector<BodyState> state(n);
+    std::vector<std::vector<HostFace>> hosts(n);
+    std::vector<uint8_t> isLeft(n, 0);
+    size_t left = 0;
+    for (uint32_t b = 0; b < n; ++b) {
+        BodyState& st = state[b];
+        if (!bodies[b].glueOptions.empty()) hosts[b] = hostFaces(bodies, b, faces, voxelMm, glueOn);
+        st.usable = usableOf(bodies[b], !hosts[b].empty());
+        st.blockers.resize(st.usable.size());
+        if (!st.usable.empty()) isLeft[b] = 1, ++left;
+    }
+    Disassembly out;
+    out.holes.assign(n, -1);
+    std::vector<size_t> chosen(n, SIZE_MAX);
+    std::vector<uint32_t> removed;
+    auto isClear = [&](const std::vector<uint32_t>& blockers) {
+        return std::all_of(blockers.begin(), blockers.end(), [&](uint32_t a) { return !isLeft[a]; });
+    };
+    // The faces a hosted body can be glued on across along direction k now: hosts in place, pins
+    // straight enough.
+    auto gluable = [&](uint32_t b, size_t k) {
+        const Vec3d d = gridDirection(holeOf(bodies, state, b, k), frameToGridMm);
+        std::vector<const HostFace*> list;
+        for (const HostFace& h : hosts[b])
+            if (isLeft[h.body] && dot(d, h.normal) >= glueOn.minCosine) list.push_back(&h);
+        return list;
+    };
+    // A body whose removal would leave a body that can only be glued on with nothing to be glued
+    // onto goes last.
+    auto isLastHost = [&](uint32_t a) {
+        for (uint32_t b = 0; b < n; ++b) {
+            if (!isLeft[b] || !state[b].canGlue()) continue;
+            bool isOther = false, isMine = false;
+            for (const HostFace& h : hosts[b]) (h.body == a ? isMine : isOther) |= bool(isLeft[h.body]);
+            if (isMine && !isOther) return true;
+        }
+        return false;
+    };
+    while (left > 0) {
+        context.throwIfCancelled();
+        // (kind, rank of the direction it can leave along, −its lowest point, index): the best to
+        // take away now. Kinds: a body no peg can hold, glued on (it leaves as soon as it can, its
+        // hosts must still be there); a body held by pegs; a body that has pegs but is glued on
+        // only when nothing else can leave; each kind those no other needs as its host first.
+        // Taking the highest first mounts the lowest first.
+        std::optional<std::tuple<int, size_t, double, uint32_t>> best;
+        for (uint32_t b = 0; b < n; ++b) {
+            if (!isLeft[b]) continue;
+            const int lastHost = isLastHost(b) ? 1 : 0;
+            const bool hasPegs = !state[b].usable.front().isGlue;
+            for (size_t k = 0; k < state[b].usable.size(); ++k) {
+                const bool isGlue = state[b].usable[k].isGlue;
+                const int kind = (isGlue ? (hasPegs ? 4 : 0) : 2) + lastHost;
+                const std::tuple<int, size_t, double, uint32_t> key{kind, k, -bodies[b].bounds.min[2], b};
+                if (best && key > *best) continue;
+                if (isGlue && gluable(b, k).empty()) continue;
+                if (!isClear(blockersOf(state, b, k, bodies, faces, frameToGridMm, voxelMm, cache))) continue;
+                best = key;
+                break;
+            }
+        }
+        if (!best) break;
+        const auto [kind, k, negLow, b] = *best;
+        if (state[b].usable[k].isGlue)
+            for (const HostFace* h : gluable(b, k)) {
+                out.gluedOn.push_back({h->hostPiece, h->piece});
+                out.before.push_back({h->body, b});
+            }
+        chosen[b] = k;
+        out.holes[b] = holeOf(bodies, state, b, k);
+        removed.push_back(b);
+        isLeft[b] = 0, --left;
+    }
+    out.order.assign(removed.rbegin(), removed.rend());
+    for (uint32_t b = 0; b < n; ++b) {
+        if (chosen[b] != SIZE_MAX) {
+            for (uint32_t a : *state[b].blockers[chosen[b]]) out.before.push_back({b, a});
+        } else if (isLeft[b]) {
+            out.stuck.push_back(b);
+            std::vector<uint32_t> in;
+            for (uint32_t a : blockersOf(state, b, 0, bodies, faces, frameToGridMm, voxelMm, cache))
+                if (isLeft[a]) in.push_back(a);
+            out.stuckBlockers.push_back(std::move(in));
+        }
+    }
+    std::sort(out.before.begin(), out.before.end());
+    out.before.erase(std::unique(out.before.begin(), out.before.end()), out.before.end());
+    std::sort(out.gluedOn.begin(), out.gluedOn.end());
+    out.gluedOn.erase(std::unique(out.gluedOn.begin(), out.gluedOn.end()), out.gluedOn.end());
+    return out;
 }
 
 mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweeps& sweeps,
-                                     const FaceContacts& faces, double voxelMm, int minPerPiece,
+                                     const FaceContacts& faces, double voxelMm, const std::vector<int>& holes,
                                      int maxPerPiece, const RunContext& context) {
     Bodies bodies;
-    for (const MountBody& piece : input.pieces)
+    for (const MountBody& piece : input.pieces) {
         bodies.list.push_back(makeBody(piece.pieces, input, sweeps, voxelMm, maxPerPiece));
-    context.throwIfCancelled();
-    // First every body held at all (a thin ear glued to the head), then by minPerPiece tenons.
-    glueWeak(bodies, 1, input, sweeps, faces, voxelMm, maxPerPiece, context);
-    glueWeak(bodies, size_t(minPerPiece), input, sweeps, faces, voxelMm, maxPerPiece, context);
-    SweepCache cache;
-    std::vector<int> holes = chosenHoles(bodies.list);
-    Trouble trouble =
-        improveDirections(bodies.list, holes, faces, sweeps.frameToGridMm(), voxelMm, cache, context);
-    // Where no choice of directions lets an order exist, glue bodies that block each other.
-    while (trouble.count() > 0 && glueTrouble(bodies, trouble, input, sweeps, faces, voxelMm, maxPerPiece)) {
-        holes = chosenHoles(bodies.list);
-        trouble =
-            improveDirections(bodies.list, holes, faces, sweeps.frameToGridMm(), voxelMm, cache, context);
+        if (bodies.list.back().isHosted()) addGlueOptions(bodies.list.back(), holes, sweeps, voxelMm);
+        context.throwIfCancelled();
     }
-    if (trouble.count() > 0) trouble.order.clear();
-    return writePlan(bodies, holes, trouble, input.pieces.size());
+    SweepCache cache;
+    const GlueOnRule glueOn;
+    Disassembly parts =
+        disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context);
+    // Bodies held by pegs but stuck may be glued on instead, along a direction no peg uses.
+    if (!parts.stuck.empty()) {
+        for (uint32_t b : parts.stuck)
+            if (bodies.list[b].glueOptions.empty()) addGlueOptions(bodies.list[b], holes, sweeps, voxelMm);
+        parts = disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context);
+    }
+    // Where no order exists, glue stuck bodies that are in each other's way into one (a few times:
+    // what gluing does not resolve is re-cut).
+    const size_t maxGlues = std::max<size_t>(4, input.pieces.size() / 4);
+    for (size_t glues = 0; !parts.stuck.empty() && glues < maxGlues; ++glues) {
+        for (size_t k = 0; k < parts.stuck.size(); ++k) {
+            std::string in;
+            for (uint32_t o : parts.stuckBlockers[k]) in += " " + bodyName(bodies.list[o]);
+            context.debug("mounting: stuck: " + bodyName(bodies.list[parts.stuck[k]]) + ", in its way:" + in);
+        }
+        if (!glueStuck(bodies, parts, input, sweeps, faces, voxelMm, maxPerPiece)) break;
+        parts = disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context);
+    }
+    return writePlan(bodies, parts, input.pieces.size());
 }
 
 }  // namespace zomefab::pieces::detail

@@ -39,7 +39,13 @@ json installationToJson(const mount::InstallationPlan& plan) {
     for (const auto& [a, b] : plan.before) before.push_back({a, b});
     json glued = json::array();
     for (const auto& [a, b] : plan.glued) glued.push_back({a, b});
-    return {{"steps", steps}, {"before", before}, {"glued", glued}, {"problems", plan.problems}};
+    json gluedOn = json::array();
+    for (const auto& [host, piece] : plan.gluedOn) gluedOn.push_back({host, piece});
+    return {{"steps", steps},
+            {"before", before},
+            {"glued", glued},
+            {"glued_on", gluedOn},
+            {"problems", plan.problems}};
 }
 
 }  // namespace

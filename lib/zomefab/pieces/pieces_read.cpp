@@ -224,6 +224,8 @@ mount::InstallationPlan planFromJson(const json& j, const std::vector<Piece>& pi
         plan.before.push_back(indexPair(pair, n, "installation.before"));
     for (const json& pair : j.value("glued", json::array()))
         plan.glued.push_back(indexPair(pair, n, "installation.glued"));
+    for (const json& pair : j.value("glued_on", json::array()))
+        plan.gluedOn.push_back(indexPair(pair, n, "installation.glued_on"));
     for (const json& problem : j.value("problems", json::array()))
         plan.problems.push_back(problem.is_string() ? problem.get<std::string>() : problem.dump());
     return plan;

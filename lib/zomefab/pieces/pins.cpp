@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "zomefab/mount/sweep.h"
+#include "zomefab/pieces/detail/mounting.h"
 
 namespace zomefab::pieces::detail {
 
@@ -75,11 +76,14 @@ struct PairFaces {
     std::vector<std::vector<Spot>> spots;
 };
 
+/// The planar faces of every pair of pieces glued together or glued on, by (lower, higher) piece;
+/// normals from the lower into the higher.
 std::map<std::pair<uint32_t, uint32_t>, PairFaces> gluedFaces(const Pieces& out, const VoxelField& field,
                                                               const GridCells& cells,
                                                               const std::vector<CellSet>& sets) {
     std::map<std::pair<uint32_t, uint32_t>, PairFaces> faces;
-    for (const auto& pair : out.plan.glued) faces[pair];
+    for (const auto& [a, b] : out.plan.glued) faces[{std::min(a, b), std::max(a, b)}];
+    for (const auto& [a, b] : out.plan.gluedOn) faces[{std::min(a, b), std::max(a, b)}];
     std::map<std::tuple<uint32_t, uint32_t, uint32_t, uint32_t>, size_t> planeOf;
     forEachForwardPair(field, [&](size_t s, size_t t) {
         if (!field.isInside(s) || !field.isInside(t) || field.owner[s] == field.owner[t]) return;
@@ -102,15 +106,22 @@ std::map<std::pair<uint32_t, uint32_t>, PairFaces> gluedFaces(const Pieces& out,
     return faces;
 }
 
-/// Up to @p count pins on the largest plane of @p f: the spot farthest from the face's centre,
-/// then each next the farthest from those chosen, where the wall is deep enough and the pin fits.
+/// Up to PinOptions::perPair pins from a into b (lower, higher piece of @p f) along @p axis, unit,
+/// from a into b; null: each plane's normal. On the largest plane (with an axis: among those it
+/// meets at most @p maxAngleCos off their normal): the spot farthest from the face's centre, then
+/// each next the farthest from those chosen, where the wall is deep enough and the pin fits.
 std::vector<AlignmentPin> pinsOnFace(const PairFaces& f, uint32_t a, uint32_t b, const VoxelField& field,
-                                     const PinOptions& o) {
-    if (f.spots.empty()) return {};
-    size_t best = 0;
-    for (size_t k = 1; k < f.spots.size(); ++k)
-        if (f.spots[k].size() > f.spots[best].size()) best = k;
+                                     const PinOptions& o, const Vec3d* axis = nullptr,
+                                     double minCosine = 0.0) {
+    size_t best = SIZE_MAX;
+    for (size_t k = 0; k < f.spots.size(); ++k) {
+        const double along = axis ? dot(*axis, scale(f.planes[k].normal, a < b ? 1.0 : -1.0)) : 1.0;
+        if (along < minCosine) continue;
+        if (best == SIZE_MAX || f.spots[k].size() > f.spots[best].size()) best = k;
+    }
+    if (best == SIZE_MAX) return {};
     const FacePlane& plane = f.planes[best];
+    const Vec3d pinAxis = axis ? *axis : scale(plane.normal, a < b ? 1.0 : -1.0);
     const double r = 0.5 * o.diameterMm;
     std::vector<Vec3d> candidates;
     Vec3d centre{0, 0, 0};
@@ -134,29 +145,47 @@ std::vector<AlignmentPin> pinsOnFace(const PairFaces& f, uint32_t a, uint32_t b,
         }
         if (pick == SIZE_MAX || (!chosen.empty() && far < 16 * r * r)) break;  // nothing left 4r away
         isTried[pick] = 1;
-        if (fits(field, a, b, candidates[pick], plane.normal, r, o.lengthMm))
-            chosen.push_back(candidates[pick]);
+        if (fits(field, a, b, candidates[pick], pinAxis, r, o.lengthMm)) chosen.push_back(candidates[pick]);
     }
     std::vector<AlignmentPin> pins;
-    for (const Vec3d& c : chosen) pins.push_back({b, false, c, plane.normal, r, o.lengthMm});
+    for (const Vec3d& c : chosen) pins.push_back({b, false, c, pinAxis, r, o.lengthMm});
     return pins;
+}
+
+/// The pins of one pair on both pieces: the pin on @p a, the socket in @p b. Returns how many.
+size_t addPins(Pieces& out, uint32_t a, uint32_t b, const std::vector<AlignmentPin>& pins) {
+    for (AlignmentPin pin : pins) {
+        out.pieces[a].pins.push_back(pin);
+        pin.partner = a;
+        pin.isSocket = true;
+        out.pieces[b].pins.push_back(pin);
+    }
+    return pins.size();
 }
 
 }  // namespace
 
 size_t placePins(Pieces& out, const VoxelField& field, const GridCells& cells,
-                 const std::vector<CellSet>& sets, const PiecesOptions& options) {
+                 const std::vector<CellSet>& sets, const PiecesOptions& options, double minCosine) {
     size_t short_ = 0;
-    for (const auto& [pair, faces] : gluedFaces(out, field, cells, sets)) {
-        const auto [a, b] = pair;
-        const std::vector<AlignmentPin> pins = pinsOnFace(faces, a, b, field, options.pins);
-        if (int(pins.size()) < options.pins.perPair) ++short_;
-        for (AlignmentPin pin : pins) {
-            out.pieces[a].pins.push_back(pin);
-            pin.partner = a;
-            pin.isSocket = true;
-            out.pieces[b].pins.push_back(pin);
-        }
+    const auto faces = gluedFaces(out, field, cells, sets);
+    auto facesOf = [&](uint32_t a, uint32_t b) -> const PairFaces& {
+        return faces.at({std::min(a, b), std::max(a, b)});
+    };
+    for (const auto& [a, b] : out.plan.glued) {
+        const uint32_t lo = std::min(a, b), hi = std::max(a, b);
+        if (int(addPins(out, lo, hi, pinsOnFace(facesOf(a, b), lo, hi, field, options.pins))) <
+            options.pins.perPair)
+            ++short_;
+    }
+    // Glued on: the pins stand on the host along the direction the piece goes on along, so its
+    // sockets slide over them as it is pushed on.
+    for (const auto& [host, piece] : out.plan.gluedOn) {
+        const Vec3d d = gridDirection(out.plan.holeOfPiece[piece], out.frameToGridMm);
+        if (int(addPins(out, host, piece,
+                        pinsOnFace(facesOf(host, piece), host, piece, field, options.pins, &d, minCosine))) <
+            options.pins.perPair)
+            ++short_;
     }
     return short_;
 }

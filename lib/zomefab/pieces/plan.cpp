@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <map>
 #include <optional>
+#include <set>
 
 #include "zomefab/core/format.h"
 #include "zomefab/core/run_context.h"
@@ -41,7 +42,7 @@ void warnShortfall(const Pieces& out, const TenonOptions& o, const RunContext& c
                  " tenons (rejected rays: " + list + "); pieces.json lists why per piece");
 }
 
-constexpr int kRecutRounds = 3;  ///< plan, re-cut the blocked pieces, plan again: at most this often
+constexpr int kRecutRounds = 4;  ///< plan, re-cut the blocked pieces, plan again: at most this often
 
 /// The box every piece's voxels and every ball lie in (grid mm): the frame sweeps' rectangle.
 Box3d planBounds(const VoxelField& field, const zome::Structure& frame, const Transform4d& frameToGridMm) {
@@ -52,8 +53,26 @@ Box3d planBounds(const VoxelField& field, const zome::Structure& frame, const Tr
     return bounds;
 }
 
-/// Re-cuts the pieces the plan could not give a direction because the frame is in the way of
-/// every one (not for want of tenons). Returns how many were cut.
+/// The pieces to re-cut: every piece the frame is in the way of along every direction with tenons,
+/// and of the pieces that keep each other from any order (placed nowhere, though free alone) the
+/// largest, one a round (cutting them all multiplies the pieces: re-cutting one often frees the rest).
+std::vector<uint32_t> piecesToRecut(const Pieces& out, const PlannerInput& input, const FrameSweeps& sweeps,
+                                    double voxelMm, int maxPerPiece) {
+    std::vector<uint32_t> list;
+    uint32_t largestStuck = kNone;
+    for (uint32_t p = 0; p < out.pieces.size(); ++p) {
+        if (out.plan.holeOfPiece[p] >= 0 || input.candidatesByHole[p].empty()) continue;
+        if (!makeBody({p}, input, sweeps, voxelMm, maxPerPiece, 1).bestFree())
+            list.push_back(p);
+        else if (largestStuck == kNone ||
+                 out.pieces[p].shellVolumeMm3 > out.pieces[largestStuck].shellVolumeMm3)
+            largestStuck = p;
+    }
+    if (largestStuck != kNone) list.push_back(largestStuck);
+    return list;
+}
+
+/// Re-cuts the pieces the plan could not place (piecesToRecut). Returns how many were cut.
 size_t recutBlocked(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
                     const PlannerInput& input, const std::vector<TenonCandidate>& candidates,
                     const FrameSweeps& sweeps, const PiecesOptions& opt, const RunContext& context) {
@@ -65,11 +84,7 @@ size_t recutBlocked(Pieces& out, VoxelField& field, const GridCells& cells, Grou
     search.edgeMarginMm = bodyRadiusMm(opt.tenons) + field.voxelMm;
     search.maxPerPiece = opt.tenons.maxPerPiece;
     size_t cut = 0;
-    const size_t pieceCount = out.pieces.size();
-    for (uint32_t p = 0; p < pieceCount; ++p) {
-        if (out.plan.holeOfPiece[p] >= 0 || input.candidatesByHole[p].empty()) continue;
-        const MountBody alone = makeBody({p}, input, sweeps, field.voxelMm, opt.tenons.maxPerPiece);
-        if (alone.bestFree()) continue;  // held on its own: unheld only with its glued group
+    for (uint32_t p : piecesToRecut(out, input, sweeps, field.voxelMm, opt.tenons.maxPerPiece)) {
         std::vector<const TenonCandidate*> mine;
         for (const TenonCandidate& c : candidates)
             if (c.piece == int64_t(p) && c.rejection.empty()) mine.push_back(&c);
@@ -81,13 +96,59 @@ size_t recutBlocked(Pieces& out, VoxelField& field, const GridCells& cells, Grou
         if (!plane) continue;
         const uint32_t q = splitPiece(out.pieces, grouping.cellSets, field, p, *plane);
         context.detail("piece " + std::to_string(p) +
-                       " meets the frame along every direction: re-cut in two (" + std::to_string(p) +
-                       " and " + std::to_string(q) + ")");
+                       " cannot be put on (the frame or other pieces in the way): re-cut in two (" +
+                       std::to_string(p) + " and " + std::to_string(q) + ")");
         ++cut;
     }
     out.recutPieces += cut;
     if (cut > 0) grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
     return cut;
+}
+
+/// The steps that rely on pegs but got none from @p tenons (their candidates' prisms would meet
+/// another piece's tenon): their candidates along their direction are marked lost in
+/// @p candidates and added to @p lost (ball, hole). Returns how many steps.
+size_t markLostTenons(const mount::InstallationPlan& plan, const TenonPlan& tenons,
+                      std::vector<TenonCandidate>& candidates, std::set<std::pair<zome::BallId, int>>& lost) {
+    size_t steps = 0;
+    for (const mount::MountStep& step : plan.steps) {
+        size_t pegs = 0;
+        bool isGluedOn = false;
+        for (uint32_t p : step.pieces) {
+            pegs += tenons.perPiece[p].size();
+            for (const auto& [host, piece] : plan.gluedOn) isGluedOn |= piece == p;
+        }
+        if (pegs > 0 || isGluedOn) continue;
+        ++steps;
+        for (TenonCandidate& c : candidates)
+            if (c.rejection.empty() && c.tenon.hole == step.hole &&
+                std::count(step.pieces.begin(), step.pieces.end(), uint32_t(c.piece))) {
+                c.rejection = "another tenon in the way";
+                lost.insert({c.tenon.ball, c.tenon.hole});
+            }
+    }
+    return steps;
+}
+
+/// The installation plan over @p candidates, planned again while a step that relies on pegs gets
+/// none (its candidates lost to other pieces' tenons: they are dropped; a few times).
+mount::InstallationPlan planOverCandidates(const Pieces& out, const VoxelField& field,
+                                           const FaceContacts& faces, const FrameSweeps& sweeps,
+                                           std::vector<TenonCandidate>& candidates,
+                                           std::set<std::pair<zome::BallId, int>>& lost,
+                                           const PiecesOptions& opt, const RunContext& context) {
+    for (int attempt = 0;; ++attempt) {
+        const PlannerInput input = plannerInput(out, field, candidates);
+        mount::InstallationPlan plan =
+            planMounting(input, sweeps, faces, field.voxelMm, tenonHoleSet(opt.tenons.holes),
+                         opt.tenons.maxPerPiece, context);
+        if (!plan.isBuildable() || attempt == 8) return plan;
+        const TenonPlan tenons = chooseTenons(candidates, plan.holeOfPiece, opt.tenons);
+        const size_t steps = markLostTenons(plan, tenons, candidates, lost);
+        if (steps == 0) return plan;
+        context.debug("mounting: " + std::to_string(steps) +
+                      " steps lost their tenons to other pieces' tenons; planning again without them");
+    }
 }
 
 /// The installation plan, re-cutting blocked pieces and planning again (a few rounds), and the
@@ -99,15 +160,18 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
     const FrameSweeps sweeps(frame, frameToGridMm, planBounds(field, frame, frameToGridMm), field.voxelMm,
                              opt.mount.frameMarginMm);
     std::vector<TenonCandidate> candidates;
+    std::set<std::pair<zome::BallId, int>> lost;  // candidates other pieces' tenons took
     for (int round = 0;; ++round) {
         const Stopwatch clock;
         candidates = findTenonCandidates(frame, frameToGridMm, probe, opt.tenons);
-        const PlannerInput input = plannerInput(out, field, candidates);
+        for (TenonCandidate& c : candidates)
+            if (c.rejection.empty() && lost.count({c.tenon.ball, c.tenon.hole}))
+                c.rejection = "another tenon in the way";
         context.debug("mounting: " + std::to_string(candidates.size()) + " tenon candidates in " +
                       formatNumber(clock.seconds(), 3) + " s");
         context.throwIfCancelled();
-        out.plan = planMounting(input, sweeps, grouping.faces, field.voxelMm, opt.tenons.minPerPiece,
-                                opt.tenons.maxPerPiece, context);
+        out.plan = planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context);
+        const PlannerInput input = plannerInput(out, field, candidates);
         context.debug("mounting: plan " + std::to_string(round) + " in " + formatNumber(clock.seconds(), 3) +
                       " s");
         if (out.plan.isBuildable() || round == kRecutRounds) break;
@@ -116,9 +180,10 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
                       " s");
         if (cut == 0) break;
     }
-    const size_t unpinned = placePins(out, field, cells, grouping.cellSets, opt);
+    const size_t unpinned = placePins(out, field, cells, grouping.cellSets, opt, GlueOnRule{}.minCosine);
     if (unpinned > 0)
-        context.warn(std::to_string(unpinned) + " of " + std::to_string(out.plan.glued.size()) +
+        context.warn(std::to_string(unpinned) + " of " +
+                     std::to_string(out.plan.glued.size() + out.plan.gluedOn.size()) +
                      " glued pairs have fewer than " + std::to_string(opt.pins.perPair) +
                      " alignment pins (the face has no room): line them up by eye when gluing");
     TenonPlan plan = chooseTenons(candidates, out.plan.holeOfPiece, opt.tenons);

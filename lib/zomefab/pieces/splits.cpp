@@ -5,11 +5,18 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <tuple>
 #include <unordered_map>
+
+#include "zomefab/mount/plan.h"
 
 namespace zomefab::pieces::detail {
 
 namespace {
+
+/// Free directions tested per half, in rank order: the pair that lets the halves be ordered
+/// across their plane is chosen among them.
+constexpr size_t kFreeOptionsPerHalf = 4;
 
 /// The 13 directions of the split planes: axes, face diagonals, body diagonals (unit).
 std::vector<Vec3d> splitDirections() {
@@ -99,33 +106,58 @@ MountBody halfBody(const VoxelGraph& g, const std::vector<uint8_t>& side, uint8_
         byHole[c->tenon.hole].second += c->score;
     }
     half.options = rankedOptions(byHole, size_t(s.maxPerPiece));
-    testPaths(half, sweeps, s.voxelMm, true);
+    testPaths(half, sweeps, s.voxelMm, kFreeOptionsPerHalf);
     return half;
 }
 
-/// Tenons of the weaker half and of both, when both halves are connected, large enough and held;
-/// else (0, 0).
-std::pair<size_t, size_t> splitValue(const VoxelGraph& g,
-                                     const std::vector<const TenonCandidate*>& candidates,
-                                     const SplitPlane& plane, const FrameSweeps& sweeps,
-                                     const SplitSearch& s) {
+/// The best pair of free directions with tenons for the halves (0: normal·x ≤ offset, 1: beyond) that
+/// lets one go on after the other across the plane (mount::faceOrder; a half moving away from the
+/// plane cannot meet the other, so the plane decides): (tenons of the weaker, of both), or (0, 0).
+std::pair<size_t, size_t> bestOrderedPair(const MountBody& a, const MountBody& b, const SplitPlane& plane,
+                                          const FrameSweeps& sweeps, size_t cap) {
+    std::pair<size_t, size_t> best{0, 0};
+    for (const DirectionOption& oa : a.options) {
+        if (!oa.isTested || !oa.isFree || oa.tenons == 0) continue;
+        const Vec3d da = gridDirection(oa.hole, sweeps.frameToGridMm());
+        for (const DirectionOption& ob : b.options) {
+            if (!ob.isTested || !ob.isFree || ob.tenons == 0) continue;
+            const mount::FaceOrder order =
+                mount::faceOrder(plane.normal, da, gridDirection(ob.hole, sweeps.frameToGridMm()));
+            if (!order.isBAfterAOk && !order.isAAfterBOk) continue;
+            const size_t ta = std::min(oa.tenons, cap), tb = std::min(ob.tenons, cap);
+            best = std::max(best, std::make_pair(std::min(ta, tb), ta + tb));
+        }
+    }
+    return best;
+}
+
+/// How good a split is, compared as a tuple: the halves that can be held (both, and ordered across
+/// the plane, is best; one is a step: the other is cut again or glued on), then the tenons of the
+/// weaker held half and of both.
+using SplitValue = std::tuple<size_t, size_t, size_t>;
+
+/// The value of cutting along @p plane: (0, 0, 0) unless both halves are connected and large
+/// enough and one at least can be held.
+SplitValue splitValue(const VoxelGraph& g, const std::vector<const TenonCandidate*>& candidates,
+                      const SplitPlane& plane, const FrameSweeps& sweeps, const SplitSearch& s) {
     const std::vector<Vec3d>& voxels = *g.voxels;
     std::vector<uint8_t> side(voxels.size());
     size_t above = 0;
     for (size_t v = 0; v < voxels.size(); ++v)
         above += side[v] = dot(plane.normal, voxels[v]) > plane.offsetMm;
     const double voxelVolume = s.voxelMm * s.voxelMm * s.voxelMm;
-    if (double(std::min(above, voxels.size() - above)) * voxelVolume < s.minVolumeMm3) return {0, 0};
-    if (!isConnected(g, side, 0) || !isConnected(g, side, 1)) return {0, 0};
+    if (double(std::min(above, voxels.size() - above)) * voxelVolume < s.minVolumeMm3) return {0, 0, 0};
+    if (!isConnected(g, side, 0) || !isConnected(g, side, 1)) return {0, 0, 0};
     const MountBody a = halfBody(g, side, 0, candidates, plane, sweeps, s);
-    const DirectionOption* oa = a.bestFree();
-    if (!oa) return {0, 0};
     const MountBody b = halfBody(g, side, 1, candidates, plane, sweeps, s);
-    const DirectionOption* ob = b.bestFree();
-    if (!ob) return {0, 0};
-    const size_t cap = size_t(s.maxPerPiece);
-    const size_t ta = std::min(oa->tenons, cap), tb = std::min(ob->tenons, cap);
-    return {std::min(ta, tb), ta + tb};
+    const DirectionOption *oa = a.bestFree(), *ob = b.bestFree();
+    if (oa && ob) {
+        const auto [weaker, both] = bestOrderedPair(a, b, plane, sweeps, size_t(s.maxPerPiece));
+        if (weaker > 0) return {2, weaker, both};
+    }
+    if (!oa && !ob) return {0, 0, 0};
+    const size_t held = std::min((oa ? oa : ob)->tenons, size_t(s.maxPerPiece));
+    return {1, held, held};
 }
 
 }  // namespace
@@ -136,7 +168,7 @@ std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
     if (voxels.size() < 2) return std::nullopt;
     const VoxelGraph graph = voxelGraph(voxels, search);
     std::optional<SplitPlane> best;
-    std::pair<size_t, size_t> bestValue{0, 0};
+    SplitValue bestValue{0, 0, 0};
     for (const double quantile : {0.5, 1.0 / 3.0, 2.0 / 3.0}) {
         for (const Vec3d& n : splitDirections()) {
             std::vector<double> along;
@@ -147,10 +179,11 @@ std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
             // Halfway between voxel centres, so no voxel lies on the plane.
             const double offset = (std::floor(along[k] / search.voxelMm) + 0.5) * search.voxelMm;
             const SplitPlane plane{n, offset};
-            const std::pair<size_t, size_t> value = splitValue(graph, candidates, plane, sweeps, search);
-            if (value.first > 0 && value > bestValue) best = plane, bestValue = value;
+            const SplitValue value = splitValue(graph, candidates, plane, sweeps, search);
+            if (std::get<0>(value) > 0 && value > bestValue) best = plane, bestValue = value;
         }
-        if (best) return best;  // the median planes first: halves of similar size
+        if (best && std::get<0>(bestValue) == 2)
+            return best;  // the median planes first: halves of similar size
     }
     return best;
 }

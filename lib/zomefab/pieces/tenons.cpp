@@ -377,10 +377,20 @@ TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, const std:
         return std::min(1.0, nearest / 100.0) + std::min(1.0, offLine / 100.0);
     };
     std::vector<uint8_t> isTaken(candidates.size(), 0);
-    // Round-robin: every piece gets its k-th tenon before any gets its (k+1)-th.
-    for (int round = 0; round < o.maxPerPiece; ++round)
-        for (size_t p = 0; p < pieceCount; ++p) {
-            if (plan.perPiece[p].size() != size_t(round)) continue;
+    // Round-robin: every piece gets its k-th tenon before any gets its (k+1)-th; in each round the
+    // pieces with the fewest candidates left choose first, so that a piece with one candidate is not
+    // left with none by a neighbour's tenon next to it.
+    auto usableCount = [&](size_t p) {
+        size_t count = 0;
+        for (size_t i : byPiece[p]) count += !isTaken[i] && rejection[i].empty() ? 1 : 0;
+        return count;
+    };
+    for (int round = 0; round < o.maxPerPiece; ++round) {
+        std::vector<std::pair<size_t, size_t>> order;  // (candidates left, piece)
+        for (size_t p = 0; p < pieceCount; ++p)
+            if (plan.perPiece[p].size() == size_t(round)) order.push_back({usableCount(p), p});
+        std::sort(order.begin(), order.end());
+        for (const auto& [left, p] : order) {
             size_t best = SIZE_MAX;
             double bestKey = -1e300;
             for (size_t i : byPiece[p]) {
@@ -397,6 +407,7 @@ TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, const std:
             plan.perPiece[p].push_back(candidates[best].tenon);
             chosen.push_back(&candidates[best].tenon);
         }
+    }
     for (size_t p = 0; p < pieceCount; ++p) {
         if (plan.perPiece[p].size() >= size_t(o.minPerPiece)) continue;
         auto& reasons = plan.shortfall[p];

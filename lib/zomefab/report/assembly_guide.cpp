@@ -131,13 +131,23 @@ std::vector<std::string> mountingSentences(const MountingStep& step) {
                         (g.pins == 0 ? std::string("no room for alignment pins: line the two up by eye")
                                      : std::to_string(g.pins) + " alignment pin" + (g.pins == 1 ? "" : "s")) +
                         ").");
+    for (const GlueJoint& g : step.gluedOnto)
+        lines.push_back("Put glue on the cut face of " + g.a + " that meets " + g.b +
+                        " (already on): " + g.a + " is glued onto it as it goes on (" +
+                        (g.pins == 0 ? std::string("no room for alignment pins: line it up by eye")
+                                     : std::to_string(g.pins) + " alignment pin" + (g.pins == 1 ? "" : "s") +
+                                           " on " + g.b + " go into its sockets") +
+                        ").");
     const Vec3d& d = zome::holeDirection(step.hole);
     lines.push_back("Approach from: " + zome::directionName(d) +
                     ". Push: " + zome::directionName(scale(d, -1.0)) +
                     formatNumbers(" (direction %+.3f, %+.3f, %+.3f).", 0.0 - d[0], 0.0 - d[1], 0.0 - d[2]));
+    if (step.tenons.empty()) {
+        lines.push_back("It has no pegs: the glue holds it.");
+        return lines;
+    }
     std::string pegs =
         "Its pegs go into " + holeWords(step.hole) + " (" + std::to_string(step.hole) + ") of ";
-    if (step.tenons.empty()) pegs += "no ball: it is held by the pieces it is glued to";
     for (size_t i = 0; i < step.tenons.size(); ++i)
         pegs += (i ? ", " : "") + ballName(step.tenons[i].ball) +
                 (step.pieces.size() > 1 ? " (" + step.tenons[i].piece + ")" : "");
@@ -178,7 +188,9 @@ std::string mountingIntroduction() {
            "line "
            "every peg up with its hole and push it straight in until the pegs are seated (4 mm). Glue a "
            "group's "
-           "pieces together first, pins into sockets, and let the glue set.";
+           "pieces together first, pins into sockets, and let the glue set. A piece no peg can hold (an "
+           "ear, the tip of a tail) is glued onto the pieces already on as it goes on: glue on its cut face, "
+           "then push it on so that its sockets slide over their pins.";
 }
 
 namespace {
@@ -251,10 +263,14 @@ nlohmann::json assemblyGuideToJson(const AssemblyGuide& guide) {
         for (const TenonLink& l : m.tenons)
             pegs.push_back({{"piece", l.piece}, {"ball", l.ball}, {"hole", l.hole}});
         for (const GlueJoint& g : m.glue) glue.push_back({{"pieces", {g.a, g.b}}, {"pins", g.pins}});
+        nlohmann::json gluedOnto = nlohmann::json::array();
+        for (const GlueJoint& g : m.gluedOnto)
+            gluedOnto.push_back({{"piece", g.a}, {"onto", g.b}, {"pins", g.pins}});
         const Vec3d& d = zome::holeDirection(m.hole);
         mounting.push_back({{"step", k + 1},
                             {"pieces", m.pieces},
                             {"glue", std::move(glue)},
+                            {"glued_onto", std::move(gluedOnto)},
                             {"hole", m.hole},
                             {"hole_color", zome::colorName(zome::holeColor(m.hole))},
                             {"from", zome::directionName(d)},

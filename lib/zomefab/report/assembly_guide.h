@@ -57,6 +57,9 @@ struct MountingStep {
     std::vector<GlueJoint> glue;      ///< how the group is glued (empty for one piece)
     int hole = -1;                    ///< the direction, 0..61
     std::vector<TenonLink> tenons;    ///< every peg of the step, by piece in step order
+    /// Pieces already on that this step's pieces are glued onto as they go on (a: this step's
+    /// piece, b: the one already on; the pins stand on b): a step no peg holds.
+    std::vector<GlueJoint> gluedOnto;
 };
 
 struct AssemblyGuide {

@@ -153,6 +153,13 @@ std::vector<MountingStep> mountingSteps(const pieces::Pieces& all) {
             for (const pieces::AlignmentPin& pin : all.pieces[a].pins) pins += pin.partner == b ? 1 : 0;
             step.glue.push_back({pieces::pieceName(all, a), pieces::pieceName(all, b), pins});
         }
+        for (const auto& [host, piece] : all.plan.gluedOn) {
+            if (std::find(plan.pieces.begin(), plan.pieces.end(), piece) == plan.pieces.end()) continue;
+            size_t pins = 0;
+            for (const pieces::AlignmentPin& pin : all.pieces[host].pins)
+                pins += pin.partner == piece && !pin.isSocket ? 1 : 0;
+            step.gluedOnto.push_back({pieces::pieceName(all, piece), pieces::pieceName(all, host), pins});
+        }
         steps.push_back(std::move(step));
     }
     return steps;

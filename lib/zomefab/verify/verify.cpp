@@ -51,15 +51,26 @@ CheckResult checkPlan(const Assembly& a, VerifyReport& report) {
             c.failures.push_back("step " + std::to_string(s + 1) +
                                  ": its pieces are not glued into one group");
     }
-    for (const auto& [x, y] : plan.glued) {
+    auto shareFace = [&](uint32_t x, uint32_t y) {
         const auto& n = a.pieces.pieces[x].neighbors;
-        if (std::none_of(n.begin(), n.end(), [&](const auto& e) { return e.first == y; }))
+        return std::any_of(n.begin(), n.end(), [&](const auto& e) { return e.first == y; });
+    };
+    for (const auto& [x, y] : plan.glued)
+        if (!shareFace(x, y))
             c.failures.push_back("pieces " + std::to_string(x) + " and " + std::to_string(y) +
                                  " are glued but share no cut face");
-    }
     for (uint32_t p = 0; p < stepOf.size(); ++p) {
         report.pieces[p].step = stepOf[p];
         if (stepOf[p] < 0) c.failures.push_back("piece " + std::to_string(p) + " is in no mounting step");
+    }
+    // A piece glued on goes on after its host, across a face they share.
+    for (const auto& [host, piece] : plan.gluedOn) {
+        if (!shareFace(host, piece))
+            c.failures.push_back("piece " + std::to_string(piece) + " is glued onto piece " +
+                                 std::to_string(host) + " but they share no cut face");
+        else if (stepOf[host] < 0 || stepOf[piece] < 0 || stepOf[host] >= stepOf[piece])
+            c.failures.push_back("piece " + std::to_string(piece) + " is glued onto piece " +
+                                 std::to_string(host) + ", which is not put on before it");
     }
     return c;
 }
@@ -73,10 +84,12 @@ void countBodies(const Assembly& a, VerifyReport& r) {
         if (step.pieces.size() > 1)
             for (uint32_t p : step.pieces) r.pieces[p].isGlued = true;
     }
+    for (const auto& [host, piece] : a.pieces.plan.gluedOn) r.pieces[piece].isGluedOn = true;
     for (const PieceResult& p : r.pieces) {
         r.tenons += p.tenons;
         if (p.pegsSeated >= 2) ++r.piecesWithTwoPegs;
         if (p.isGlued) ++r.gluedPieces;
+        if (p.isGluedOn) ++r.gluedOnPieces;
     }
 }
 
@@ -125,14 +138,19 @@ VerifyReport verifyAssembly(const Assembly& a, const VerifyOptions& o, const Run
     context.progress("verify", 0.4);
     detail::checkPaths(a, geometry, o, r, context);
     countBodies(a, r);
-    CheckResult held{"held", "every piece or glued group held by a seated peg", 0, {}};
+    CheckResult held{"held",
+                     "every piece or glued group held by a seated peg or glued onto a piece put on before it",
+                     0,
+                     {}};
     for (const mount::MountStep& step : a.pieces.plan.steps) {
         ++held.checked;
         size_t pegs = 0;
-        for (uint32_t p : step.pieces) pegs += r.pieces[p].pegsSeated;
-        if (pegs == 0)
+        bool isGluedOn = false;
+        for (uint32_t p : step.pieces) pegs += r.pieces[p].pegsSeated, isGluedOn |= r.pieces[p].isGluedOn;
+        if (pegs == 0 && !isGluedOn)
             held.failures.push_back("step " + std::to_string(&step - a.pieces.plan.steps.data() + 1) +
-                                    " (piece " + std::to_string(step.pieces[0]) + "): no peg holds it");
+                                    " (piece " + std::to_string(step.pieces[0]) +
+                                    "): no peg holds it and it is glued onto nothing");
     }
     r.checks.push_back(held);
     context.progress("verify", 1.0);
@@ -156,13 +174,15 @@ nlohmann::json verifyReportJson(const VerifyReport& r) {
                           {"pegs_seated", p.pegsSeated},
                           {"worst_axis_deg", p.worstAxisDeg},
                           {"worst_clearance_mm", p.worstClearanceMm},
-                          {"glued", p.isGlued}});
+                          {"glued", p.isGlued},
+                          {"glued_on", p.isGluedOn}});
     return {{"passed", r.passed()},
             {"bodies", r.bodies},
             {"bodies_with_two_pegs", r.bodiesWithTwoPegs},
             {"pieces", r.pieces.size()},
             {"pieces_with_two_pegs", r.piecesWithTwoPegs},
             {"glued_pieces", r.gluedPieces},
+            {"glued_on_pieces", r.gluedOnPieces},
             {"tenons", r.tenons},
             {"checks", checks},
             {"per_piece", pieces}};
@@ -174,7 +194,8 @@ std::vector<std::string> verifySummaryLines(const VerifyReport& r) {
     for (const CheckResult& c : r.checks)
         if (c.passed()) ok += (ok.empty() ? "" : ", ") + c.name + " (" + std::to_string(c.checked) + ")";
     lines.push_back("verify: " + std::to_string(r.pieces.size()) + " pieces in " + std::to_string(r.bodies) +
-                    " mounting steps (" + std::to_string(r.gluedPieces) + " pieces glued into groups); " +
+                    " mounting steps (" + std::to_string(r.gluedPieces) + " pieces glued into groups, " +
+                    std::to_string(r.gluedOnPieces) + " glued onto pieces already on); " +
                     std::to_string(r.bodiesWithTwoPegs) + " of " + std::to_string(r.bodies) +
                     " steps held by 2 or more pegs; passed: " + (ok.empty() ? "none" : ok));
     for (const CheckResult& c : r.checks) {

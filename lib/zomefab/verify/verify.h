@@ -79,6 +79,7 @@ struct PieceResult {
     double worstAxisDeg = 0.0;    ///< largest measured deviation of a peg from the direction
     double worstClearanceMm = 0;  ///< smallest gap found between a peg and its hole's walls
     bool isGlued = false;         ///< part of a glued group
+    bool isGluedOn = false;       ///< glued onto a piece put on before it (no peg may hold it)
 };
 
 struct VerifyReport {
@@ -88,6 +89,7 @@ struct VerifyReport {
     size_t bodiesWithTwoPegs = 0;  ///< held by at least two seated pegs
     size_t piecesWithTwoPegs = 0;
     size_t gluedPieces = 0;
+    size_t gluedOnPieces = 0;
     size_t tenons = 0;
     bool passed() const;
 };

@@ -6,6 +6,7 @@
 /// pieces from the cells (cell_pieces.cpp). docs/partition.md explains each.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -17,11 +18,15 @@
 #include "zomefab/partition/alpha_expansion.h"
 #include "zomefab/partition/face_graph.h"
 #include "zomefab/partition/partition.h"
+#include "zomefab/zome/structure.h"
 
 namespace zomefab::partition::detail {
 
 inline constexpr uint32_t kNone = 0xFFFFFFFFu;
 inline const double kPi = std::acos(-1.0);
+/// Balls and struts are taken this much larger in the mountability test (mm): the pieces stage's
+/// frame margin (1 mm) and a millimetre for the faces standing in for the wall's voxels.
+inline constexpr double kMountMarginMm = 2.0;
 
 /// "200 x 200 x 200 mm"
 inline std::string sizeText(const Vec3d& v) {
@@ -78,6 +83,30 @@ bool fitsPrinter(const std::vector<Vec3d>& pts, const Vec3d& printer, double mar
 
 /// The printer-fit test of face sets (docs/partition.md §4), with one stamp array to gather
 /// vertices without repeats.
+/// Per face, the hole directions (bit h for zome hole h) along which the face's wall, pushed off
+/// from its place, runs into the frame: one of its inner points (points of the face about
+/// @p pixelMm apart, @p wallMm behind the surface) has a ball or a strut, grown by @p marginMm,
+/// ahead of it on its line. Depth rasters of @p pixelMm, one per direction, in parallel
+/// (docs/partition.md §4, "Mountable").
+std::vector<uint64_t> frameBlockedDirections(const TriMesh& mesh, const FaceGraph& graph,
+                                             const zome::Structure& frame, double wallMm, double marginMm,
+                                             double pixelMm = 2.0);
+
+/// A region's area that each hole direction cannot take (frameBlockedDirections): additive, so
+/// the profile of a union is the sum of the profiles.
+struct MountProfile {
+    std::array<double, zome::kHoleCount> blockedMm2{};
+    double areaMm2Total = 0.0;
+    Vec3d normalMm2{0, 0, 0};  ///< the faces' normals weighted by their areas
+    void addFace(double areaMm2, const Vec3d& normal, uint64_t blockedHoles);
+    void add(const MountProfile& other);
+    /// The direction with the least blocked area; of those, the one nearest the region's mean
+    /// normal (the one tenons can use), then the lowest.
+    int freestHole() const;
+    /// Some direction leaves at most @p share of the area blocked.
+    bool isMountable(double share) const;
+};
+
 struct FitTester {
     const TriMesh& mesh;
     const FaceGraph& graph;
@@ -85,12 +114,26 @@ struct FitTester {
     const RunContext& run;
     std::vector<uint32_t> stamp;
     uint32_t stampValue = 0;
+    /// Per face: frameBlockedDirections; empty: regions are not tested for a direction.
+    std::vector<uint64_t> blocked = {};
+    double blockedShare = 0.0;  ///< PartitionOptions::mountBlockedShare
 
     PrinterFit fitOf(const std::vector<uint32_t>& faces) {
         const std::vector<Vec3d> pts = faceVertices(mesh, faces, stamp, stampValue);
         return fitInPrinter(pts, fab.printerMm, fab.fitMarginMm);
     }
+    MountProfile profileOf(const std::vector<uint32_t>& faces) const;
+    /// Some hole direction pushes the region's wall off the frame (all but blockedShare of it).
+    bool isMountable(const std::vector<uint32_t>& faces) const;
+    /// Fits the printer and is mountable.
+    bool fits(const std::vector<uint32_t>& faces) { return isMountable(faces) && fitOf(faces).fits; }
 };
+
+/// Splits @p faces, which fit the printer but no direction can mount, between the faces their
+/// freest direction cannot take and the others: by the plane halfway between the two parts'
+/// centroids, normal to the line joining them. False when that leaves a side empty.
+bool splitUnmountable(const FitTester& cx, const std::vector<uint32_t>& faces, std::vector<uint32_t>& lo,
+                      std::vector<uint32_t>& hi);
 
 /// Does each of @p faceSets fit the printer (its vertices' oriented box, docs/partition.md §4)?
 /// Vertex lists are gathered serially (one stamp array), the fit tests run in parallel; the result
@@ -211,7 +254,7 @@ void runSchedule(const Surface& S, const Problems& P, const PartitionOptions& op
 /// regions of one training class (after any bisection); merged regions keep their classes, so
 /// the SVM still sees each as it was cut, and form one group, which makePieces turns into one
 /// piece of several cells.
-void mergeRegions(const Surface& S, const Fabrication& fab, const PartitionOptions& opt, Classes& C,
+void mergeRegions(const Surface& S, const FitTester& fits, const PartitionOptions& opt, Classes& C,
                   PartitionResult& res, const RunContext& run);
 
 /// A new training class for @p faces, attached to the ball most of them are nearest to

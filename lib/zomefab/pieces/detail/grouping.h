@@ -43,7 +43,8 @@ struct CutContact {
     size_t voxelFaces = 0;
 };
 /// The cut faces between pieces: for the pieces (a, b), a < b, one entry per plane they share,
-/// the plane between a cell of a and a cell of b, or a plane one was re-cut along
+/// the plane between a cell of a and a cell of b, or a plane one was re-cut along; where two pieces
+/// share a cell and no plane separates them, the voxels' border with its mean normal
 /// (docs/mounting.md, "Order").
 using FaceContacts = std::map<std::pair<uint32_t, uint32_t>, std::vector<CutContact>>;
 

@@ -23,6 +23,11 @@
 
 namespace zomefab::pieces::detail {
 
+/// Cut faces of fewer voxel faces than this do not order their two pieces by their plane: where three
+/// cells meet, a few voxels of two pieces can lie across a plane that is not the seam's, with any
+/// normal. Their voxels take part in the sweeps between the two instead (a voxel of tolerance).
+inline constexpr size_t kMinOrderFaceVoxels = 50;
+
 /// One direction a body could take: its hole, the tenons it would get, whether its path is free.
 struct DirectionOption {
     int hole = -1;
@@ -44,9 +49,14 @@ struct MountBody {
     std::vector<uint8_t> isNearCut;
     Box3d bounds;
     std::vector<DirectionOption> options;
+    /// For a body no peg can hold (no free direction with a tenon), or one the order leaves stuck:
+    /// every direction of the hole set, tested, for gluing it onto a piece already in place as it
+    /// goes on. Empty otherwise.
+    std::vector<DirectionOption> glueOptions;
 
     /// The best direction with a free path and at least one tenon, or null.
     const DirectionOption* bestFree() const;
+    bool isHosted() const { return !bestFree(); }
 };
 
 /// The frame drawn along each hole direction (balls and struts grown by the margin), and the test
@@ -88,43 +98,68 @@ PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
 std::vector<DirectionOption> rankedOptions(const std::map<int, std::pair<size_t, double>>& byHole,
                                            size_t cap);
 /// Tests the options of @p body not yet tested for a free path against the frame: all (in
-/// parallel), or with @p isFirstFreeOnly in rank order up to the first free one (a trial body).
-void testPaths(MountBody& body, const FrameSweeps& sweeps, double voxelMm, bool isFirstFreeOnly = false);
+/// parallel) when @p freeWanted is 0, else in rank order until that many are free (a trial body).
+void testPaths(MountBody& body, const FrameSweeps& sweeps, double voxelMm, size_t freeWanted = 0);
 
-/// The body of @p members (the union of their voxels) with its direction options ranked and each
-/// tested against the frame.
+/// The body of @p members (the union of their voxels) with its direction options ranked and
+/// tested against the frame as testPaths does.
 MountBody makeBody(const std::vector<uint32_t>& members, const PlannerInput& input, const FrameSweeps& sweeps,
-                   double voxelMm, int maxPerPiece, bool isFirstFreeOnly = false);
+                   double voxelMm, int maxPerPiece, size_t freeWanted = 0);
 
-/// Remembered sweeps between bodies that do not touch: (moving, still, hole) → it runs into it.
+/// Hole @p hole's direction in the grid's mm (unit).
+Vec3d gridDirection(int hole, const Transform4d& frameToGridMm);
+
+/// Fills @p body's glueOptions when no peg can hold it: every hole of @p holes, each tested for a
+/// free path (in parallel).
+void addGlueOptions(MountBody& body, const std::vector<int>& holes, const FrameSweeps& sweeps,
+                    double voxelMm);
+
+/// Remembered sweeps between bodies: (moving, still, hole) → moving, pushed off along hole, runs
+/// into still's voxels.
 using SweepCache = std::map<std::tuple<std::vector<uint32_t>, std::vector<uint32_t>, int>, bool>;
 
-/// What keeps a choice of directions from an order: pairs of bodies that block each other both
-/// ways, the bodies of a cycle when the rest has one, and otherwise the order and its relation.
-struct Trouble {
-    std::vector<std::pair<uint32_t, uint32_t>> deadlocks;  ///< body indices
-    std::vector<uint32_t> cycle;
-    std::vector<uint32_t> order;
+/// A mounting order found by taking the assembly apart (docs/mounting.md, "Order"). Whether a body
+/// can go on after another depends on its own direction only, and taking bodies away never stops
+/// another from leaving, so removing, while any can be removed, one that can (along a direction
+/// it may take) finds an order whenever one exists for some choice of directions; the reverse is
+/// the mounting order. The bodies that are left are @p stuck: none of them can go on last among them.
+struct Disassembly {
+    std::vector<uint32_t> order;  ///< mounting order of the bodies that could be placed
+    std::vector<int> holes;       ///< per body: its direction; −1 when it has none or is stuck
+    /// (a, b): body a must go on before body b: along its chosen direction, a cannot go on after b.
     std::vector<std::pair<uint32_t, uint32_t>> before;
-    size_t count() const { return deadlocks.size() + cycle.size(); }
+    std::vector<uint32_t> stuck;  ///< bodies with directions that no order can place
+    /// Per stuck body: the stuck bodies in the way of its best direction.
+    std::vector<std::vector<uint32_t>> stuckBlockers;
+    /// (host piece, piece): a hosted body's piece glued onto a piece of a body placed before it.
+    std::vector<std::pair<uint32_t, uint32_t>> gluedOn;
 };
 
-/// The order constraints between @p bodies for the directions @p holeOfBody (−1: none, no
-/// constraint): neighbours by their cut faces (mount::faceOrder), other bodies by pushing one off
-/// past the other's voxels; then an order, bottom first.
-Trouble blockingTrouble(const std::vector<MountBody>& bodies, const std::vector<int>& holeOfBody,
-                        const FaceContacts& faces, const Transform4d& frameToGridMm, double voxelMm,
-                        SweepCache& cache);
+/// What glues a hosted body on: the smallest common cut face (mm²) and how straight its pins go
+/// into it (the cosine of the largest angle between the direction and the face's normal).
+struct GlueOnRule {
+    double minFaceMm2 = 150.0;
+    double minCosine = 0.5;
+};
+
+/// The disassembly of @p bodies over the directions each may take (free and with tenons, in rank
+/// order; among the bodies that can go on last, the one that can along its best-ranked direction,
+/// then the highest). A hosted body (MountBody::glueOptions) goes on along a free direction while a
+/// body it can be glued onto (@p glueOn) is in place; hosted bodies leave first, so they go on as
+/// late as they can. Bodies with no direction at all take no part (Disassembly::holes −1).
+Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts& faces,
+                        const Transform4d& frameToGridMm, double voxelMm, const GlueOnRule& glueOn,
+                        SweepCache& cache, const RunContext& context);
 
 /// Voxel faces between the pieces of two bodies (their contact area, in voxel faces).
 size_t bodyContact(const MountBody& a, const MountBody& b, const FaceContacts& faces);
 
-/// The plan: pieces that no free direction holds, then those held by fewer than @p minPerPiece
-/// tenons, glued to the neighbour that gives their union the most tenons (when that is more); a free
-/// direction per body, changed where bodies block each other until an order exists, bodies that still block
-/// each other glued; the order (lowest first). What could not be resolved is in InstallationPlan::problems.
+/// The plan: a body per piece, a piece no peg can hold glued onto a neighbour as it goes on
+/// (along a direction of @p holes), the disassembly's directions and order, and bodies that are
+/// stuck glued into one until an order exists. What could not be resolved is in
+/// InstallationPlan::problems.
 mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweeps& sweeps,
-                                     const FaceContacts& faces, double voxelMm, int minPerPiece,
+                                     const FaceContacts& faces, double voxelMm, const std::vector<int>& holes,
                                      int maxPerPiece, const RunContext& context);
 
 }  // namespace zomefab::pieces::detail

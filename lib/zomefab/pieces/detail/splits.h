@@ -33,11 +33,12 @@ struct SplitSearch {
 };
 
 /// The best plane that cuts the piece of @p voxels (all its inside voxels' centres) into two
-/// connected halves, each with a free direction along
-/// which at least one of its tenon candidates (@p candidates: the piece's usable ones) holds it,
-/// the one whose weaker half has the most tenons. Planes tried: 13 directions (the axes, the face
-/// and the body diagonals of the grid) through the median of the piece's voxels along each, then
-/// through its thirds. Empty when none works.
+/// connected halves: both with a free direction along which at least one of its tenon candidates
+/// (@p candidates: the piece's usable ones) holds it, in directions that let one go on after the
+/// other across the plane, the one whose weaker half has the most tenons; else one half held
+/// (the other is cut again, or glued on). Planes tried: 13 directions (the axes, the face and the
+/// body diagonals of the grid) through the median of the piece's voxels along each, then through
+/// its thirds. Empty when none works.
 std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
                                     const std::vector<const TenonCandidate*>& candidates,
                                     const FrameSweeps& sweeps, const SplitSearch& search);

@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file The mounting order (docs/mounting.md, "Order"): the disassembly finds an order whenever
+/// one exists for some choice of directions, names the bodies that keep each other from any, and
+/// places a body no peg can hold after a piece it can be glued onto. Bodies are built by hand:
+/// slabs of voxel centres with their direction options and cut faces.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+
+#include "zomefab/core/run_context.h"
+#include "zomefab/pieces/detail/mounting.h"
+#include "zomefab/zome/holes.h"
+
+using namespace zomefab;
+using namespace zomefab::pieces::detail;
+
+namespace {
+
+const int kUp = zome::nearestHole({0, 0, 1});
+const int kDown = zome::nearestHole({0, 0, -1});
+const int kRight = zome::nearestHole({1, 0, 0});
+
+/// A body of one piece: a slab of 1 mm voxels over [x0, x1] × [0, 10] × [z0, z1], every voxel on
+/// its surface (the planner only ever asks for those).
+MountBody slab(uint32_t piece, double x0, double x1, double z0, double z1) {
+    MountBody b;
+    b.pieces = {piece};
+    for (double x = x0; x <= x1 + 1e-9; x += 1.0)
+        for (double y = 0; y <= 10 + 1e-9; y += 1.0)
+            for (double z = z0; z <= z1 + 1e-9; z += 1.0) {
+                b.voxels.push_back({x, y, z});
+                b.isNearCut.push_back(0);
+                b.bounds.expand({x, y, z});
+            }
+    return b;
+}
+
+/// A direction the body could take: free of the frame, with @p tenons tenons.
+DirectionOption option(int hole, size_t tenons) {
+    DirectionOption o;
+    o.hole = hole;
+    o.tenons = tenons;
+    o.isTested = true;
+    o.isFree = true;
+    return o;
+}
+
+Disassembly disassembleAll(const std::vector<MountBody>& bodies, const FaceContacts& faces = {}) {
+    SweepCache cache;
+    return disassemble(bodies, faces, Transform4d::identity(), 1.0, GlueOnRule{}, cache, RunContext::silent());
+}
+
+}  // namespace
+
+TEST_CASE("mounting: a body in another's path goes on first") {
+    // B lies under A; B comes down from above (pushed off upward), so it must pass A's place first.
+    MountBody a = slab(0, 0, 10, 20, 25), b = slab(1, 0, 10, 0, 5);
+    a.options = {option(kUp, 2)};
+    b.options = {option(kUp, 2)};
+    const Disassembly d = disassembleAll({a, b});
+    CHECK(d.stuck.empty());
+    REQUIRE(d.order.size() == 2);
+    CHECK(d.order[0] == 1);
+    CHECK(d.order[1] == 0);
+    CHECK(d.holes[0] == kUp);
+    CHECK(d.holes[1] == kUp);
+    CHECK(std::count(d.before.begin(), d.before.end(), std::make_pair(uint32_t(1), uint32_t(0))) == 1);
+}
+
+TEST_CASE("mounting: each body takes a direction that lets an order exist, not its best one") {
+    // A's best direction (down) runs into B below it; its second (up) is free. B can only go up,
+    // through A's place. The only order: B first (up), then A (up).
+    MountBody a = slab(0, 0, 10, 20, 25), b = slab(1, 0, 10, 0, 5);
+    a.options = {option(kDown, 4), option(kUp, 1)};
+    b.options = {option(kUp, 2)};
+    const Disassembly d = disassembleAll({a, b});
+    CHECK(d.stuck.empty());
+    CHECK(d.holes[0] == kUp);
+    REQUIRE(d.order.size() == 2);
+    CHECK(d.order.front() == 1);
+}
+
+TEST_CASE("mounting: two bodies in each other's way along every direction are stuck, and named") {
+    MountBody a = slab(0, 0, 10, 0, 5), b = slab(1, 0, 10, 20, 25);
+    a.options = {option(kUp, 2)};    // runs into B
+    b.options = {option(kDown, 2)};  // runs into A
+    const Disassembly d = disassembleAll({a, b});
+    CHECK(d.order.empty());
+    CHECK(d.stuck == std::vector<uint32_t>{0, 1});
+    REQUIRE(d.stuckBlockers.size() == 2);
+    CHECK(d.stuckBlockers[0] == std::vector<uint32_t>{1});
+    CHECK(d.stuckBlockers[1] == std::vector<uint32_t>{0});
+    CHECK(d.holes[0] == -1);
+}
+
+TEST_CASE("mounting: a cut face lets the neighbour slide along it or leave it, never go into it") {
+    // A and B side by side, touching across the plane x = 10.5 (normal from A into B: +x).
+    MountBody a = slab(0, 0, 10, 0, 10), b = slab(1, 11, 21, 0, 10);
+    for (MountBody* m : {&a, &b}) std::fill(m->isNearCut.begin(), m->isNearCut.end(), 1);
+    const FaceContacts faces = {{{0, 1}, {CutContact{{1, 0, 0}, 121}}}};
+    a.options = {option(kRight, 2)};  // A pushed off to the right goes into B: A first
+    b.options = {option(kUp, 2)};     // B slides off along the face
+    const Disassembly d = disassembleAll({a, b}, faces);
+    CHECK(d.stuck.empty());
+    REQUIRE(d.order.size() == 2);
+    CHECK(d.order[0] == 0);
+    // Both pushed into each other: stuck by the face alone.
+    b.options = {option(zome::nearestHole({-1, 0, 0}), 2)};
+    CHECK(disassembleAll({a, b}, faces).stuck.size() == 2);
+}
+
+TEST_CASE("mounting: a body no peg can hold is glued onto a piece put on before it") {
+    // C (no tenons) sits on top of A, across the plane z = 10.5; it goes on from above after A.
+    MountBody a = slab(0, 0, 10, 0, 10), c = slab(1, 0, 10, 11, 15);
+    for (MountBody* m : {&a, &c}) std::fill(m->isNearCut.begin(), m->isNearCut.end(), 1);
+    const FaceContacts faces = {{{0, 1}, {CutContact{{0, 0, 1}, 400}}}};
+    a.options = {option(kRight, 2)};
+    c.glueOptions = {option(kRight, 0), option(kUp, 0)};
+    c.glueOptions[0].isFree = false;  // the frame is in the way to the right
+    REQUIRE(c.isHosted());
+    const Disassembly d = disassembleAll({a, c}, faces);
+    CHECK(d.stuck.empty());
+    REQUIRE(d.order.size() == 2);
+    CHECK(d.order[0] == 0);
+    CHECK(d.holes[1] == kUp);
+    CHECK(d.gluedOn == std::vector<std::pair<uint32_t, uint32_t>>{{0, 1}});
+    // A face too small to glue on, or met too obliquely, gives it nothing to hold on to.
+    const FaceContacts tiny = {{{0, 1}, {CutContact{{0, 0, 1}, 20}}}};
+    CHECK(disassembleAll({a, c}, tiny).holes[1] == -1);
+    c.glueOptions = {option(kRight, 0)};
+    CHECK(disassembleAll({a, c}, faces).holes[1] == -1);
+}
+
+TEST_CASE("mounting: a piece glued on goes on before its only host leaves") {
+    // A holds; C sits on A, D beside C (across x = 10.5). Neither C nor D has pegs: D can only be
+    // glued onto C, so C must not be taken away first, though it comes first by index.
+    MountBody a = slab(0, 0, 10, 0, 10), c = slab(1, 0, 10, 11, 15), d = slab(2, 11, 21, 11, 15);
+    for (MountBody* m : {&a, &c, &d}) std::fill(m->isNearCut.begin(), m->isNearCut.end(), 1);
+    const FaceContacts faces = {{{0, 1}, {CutContact{{0, 0, 1}, 400}}},
+                                {{1, 2}, {CutContact{{1, 0, 0}, 400}}}};
+    a.options = {option(zome::nearestHole({-1, 0, 0}), 2)};
+    c.glueOptions = {option(kUp, 0)};
+    d.glueOptions = {option(kRight, 0)};
+    const Disassembly r = disassembleAll({a, c, d}, faces);
+    CHECK(r.stuck.empty());
+    CHECK(r.order == std::vector<uint32_t>{0, 1, 2});
+    CHECK(r.gluedOn == std::vector<std::pair<uint32_t, uint32_t>>{{0, 1}, {1, 2}});
+}
