@@ -95,22 +95,28 @@ TEST_CASE("cost_report: hollow and solid cases against the octree baseline") {
         CHECK(c->zomefab.filament.costUsd ==
               doctest::Approx(filamentUse(c->zomefab.print.filamentMm3, FilamentOptions{}).costUsd));
         CHECK(c->savedFilamentPercent > 0.0);
-        // Printed whole: one part, fewer perimeters than the octree's 8 parts, so less than the
-        // baseline; the savings against it are 1 − ZomeFab / whole.
+        // Printed whole: one part, fewer perimeters than the octree's 8 parts, so less plastic in
+        // the part than the baseline, but a sphere printed whole stands on supports under its lower
+        // half, each octree part on a cut face; the savings against it are 1 − ZomeFab / whole.
         CHECK(c->whole.print.parts == 1);
-        CHECK(c->whole.print.filamentMm3 <= c->baseline.print.filamentMm3);
+        CHECK(c->whole.print.filamentMm3 - c->whole.print.supportMm3 <=
+              c->baseline.print.filamentMm3 - c->baseline.print.supportMm3);
+        CHECK(c->whole.print.supportMm3 > c->baseline.print.supportMm3);
+        CHECK(c->whole.print.supportMm3 > 0.0);
         CHECK(c->whole.print.hours() <= c->baseline.print.hours());
         CHECK(c->savedTimeVsWholePercent ==
               doctest::Approx(100 * (1 - c->zomefab.totalHours() / c->whole.totalHours())));
         CHECK(c->savedFilamentVsWholePercent ==
               doctest::Approx(100 * (1 - c->zomefab.print.filamentMm3 / c->whole.print.filamentMm3)));
     }
-    CHECK(solid.whole.print.filamentMm3 == doctest::Approx(r.objectVolumeMm3).epsilon(1e-6));
+    CHECK(solid.whole.print.filamentMm3 - solid.whole.print.supportMm3 ==
+          doctest::Approx(r.objectVolumeMm3).epsilon(1e-6));
     // The paper's observation (§7.2): the benefit grows with the infill rate.
     CHECK(solid.savedMaterialPercent > hollow.savedMaterialPercent);
     CHECK(solid.savedTimePercent > hollow.savedTimePercent);
     // At 100 % the baseline uses the object's volume in plastic.
-    CHECK(solid.baseline.print.filamentMm3 == doctest::Approx(r.objectVolumeMm3).epsilon(1e-6));
+    CHECK(solid.baseline.print.filamentMm3 - solid.baseline.print.supportMm3 ==
+          doctest::Approx(r.objectVolumeMm3).epsilon(1e-6));
 
     const nlohmann::json j = costReportToJson(r);
     CHECK(j["source"] == "estimator");
@@ -125,6 +131,16 @@ TEST_CASE("cost_report: hollow and solid cases against the octree baseline") {
     CHECK(j["cases"][1]["whole"]["print"]["parts"] == 1);
     CHECK(j["cases"][0]["saved_filament_vs_whole_percent"].is_number());
     CHECK(md.find("| solid (100%) | ZomeFab |") != std::string::npos);
+    CHECK(j["supports_counted"] == true);
+    CHECK(j["cases"][0]["whole"]["print"]["support_mm3"].get<double>() > 0);
+    CHECK(md.find("Automatic supports are counted on every side") != std::string::npos);
+    // Without supports counted, no part carries any.
+    CostOptions none;
+    none.countSupports = false;
+    const CostReport bare =
+        costReport(sphere.object, test::pointersTo(sphere.pieces), parts, Fabrication{}, none);
+    CHECK(bare.cases[0].whole.print.supportMm3 == 0.0);
+    CHECK(bare.cases[0].whole.print.filamentMm3 < hollow.whole.print.filamentMm3);
 }
 
 TEST_CASE("cost_report: a part the slicer fails on is estimated instead, with a warning") {

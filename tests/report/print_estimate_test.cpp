@@ -160,3 +160,24 @@ TEST_CASE("print_estimate: the octree baseline cuts until every part fits, and k
     }
     CHECK_THROWS_AS(octreeParts(makeBox({0, 0, 0}, {10, 10, 10}), {0, 200, 200}), Error);
 }
+
+TEST_CASE("print_estimate: supports under an overhang, none under a cube on the bed") {
+    // A table: a 10 mm stem carrying a 40 × 40 × 5 mm top 30 mm up. Its top's underside overhangs.
+    TriMesh table = makeBox({15, 15, 0}, {25, 25, 30});
+    appendMesh(table, makeBox({0, 0, 30}, {40, 40, 35}));
+    PrintSettings s;
+    s.supports = true;
+    const PrintRates rates;
+    const PrintEstimate withSupport = estimatePrint(table, s);
+    // The columns under the top: (40² − 10²) mm² × 30 mm, of which supportShare is printed.
+    // (The columns are sampled on a 2 mm grid: the top's rim and the stem's edge within a cell.)
+    CHECK(withSupport.supportMm3 == doctest::Approx(rates.supportShare * (1600 - 100) * 30).epsilon(0.15));
+    s.supports = false;
+    const PrintEstimate without = estimatePrint(table, s);
+    CHECK(without.supportMm3 == 0.0);
+    CHECK(withSupport.filamentMm3 == doctest::Approx(without.filamentMm3 + withSupport.supportMm3));
+    CHECK(withSupport.seconds ==
+          doctest::Approx(without.seconds + withSupport.supportMm3 * rates.supportSPerMm3));
+    s.supports = true;
+    CHECK(estimatePrint(makeBox({0, 0, 0}, {40, 40, 40}), s).supportMm3 == 0.0);
+}

@@ -241,12 +241,13 @@ void prepareSurface(Surface& S, const PartitionOptions& opt, PartitionResult& re
         std::vector<uint32_t> comp2;
         res.nearestPartitions = labelComponents(S.graph, res.nearestLabels, comp2);
     }
-    // A frame made for another mesh (or another scale) leaves the surface far from every ball.
+    // A frame made for another mesh (or another scale) leaves the surface far from every ball; a
+    // small frame in a thin object (a few balls joined by struts) may lie half the object away.
     std::vector<double> d(S.faceCount);
     for (size_t f = 0; f < S.faceCount; ++f) d[f] = S.near.distancesMm[f * size_t(S.k)];
     std::nth_element(d.begin(), d.begin() + long(S.faceCount / 2), d.end());
     const double median = d[S.faceCount / 2];
-    if (median > 5.0 * S.b0)
+    if (median > std::max(5.0 * S.b0, 0.5 * norm(boundingBox(S.mesh).size())))
         throw Error(
             ErrorCode::InvalidInput,
             formatNumbers("frame and mesh do not match: the surface lies a median %.0f mm (%.1f b0) from the "

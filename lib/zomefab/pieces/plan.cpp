@@ -42,7 +42,7 @@ void warnShortfall(const Pieces& out, const TenonOptions& o, const RunContext& c
                  " tenons (rejected rays: " + list + "); pieces.json lists why per piece");
 }
 
-constexpr int kRecutRounds = 4;  ///< plan, re-cut the blocked pieces, plan again: at most this often
+constexpr int kRecutRounds = 5;  ///< plan, re-cut the blocked pieces, plan again: at most this often
 
 /// The box every piece's voxels and every ball lie in (grid mm): the frame sweeps' rectangle.
 Box3d planBounds(const VoxelField& field, const zome::Structure& frame, const Transform4d& frameToGridMm) {
@@ -55,20 +55,21 @@ Box3d planBounds(const VoxelField& field, const zome::Structure& frame, const Tr
 
 /// The pieces to re-cut: every piece the frame is in the way of along every direction with tenons,
 /// and of the pieces that keep each other from any order (placed nowhere, though free alone) the
-/// largest, one a round (cutting them all multiplies the pieces: re-cutting one often frees the rest).
+/// larger half (cutting them all multiplies the pieces: re-cutting some often frees the rest).
 std::vector<uint32_t> piecesToRecut(const Pieces& out, const PlannerInput& input, const FrameSweeps& sweeps,
                                     double voxelMm, int maxPerPiece) {
     std::vector<uint32_t> list;
-    uint32_t largestStuck = kNone;
+    std::vector<std::pair<double, uint32_t>> stuck;  // (−volume, piece)
     for (uint32_t p = 0; p < out.pieces.size(); ++p) {
         if (out.plan.holeOfPiece[p] >= 0 || input.candidatesByHole[p].empty()) continue;
         if (!makeBody({p}, input, sweeps, voxelMm, maxPerPiece, 1).bestFree())
             list.push_back(p);
-        else if (largestStuck == kNone ||
-                 out.pieces[p].shellVolumeMm3 > out.pieces[largestStuck].shellVolumeMm3)
-            largestStuck = p;
+        else
+            stuck.push_back({-out.pieces[p].shellVolumeMm3, p});
     }
-    if (largestStuck != kNone) list.push_back(largestStuck);
+    std::sort(stuck.begin(), stuck.end());
+    for (size_t k = 0; k < (stuck.size() + 1) / 2; ++k) list.push_back(stuck[k].second);
+    std::sort(list.begin(), list.end());
     return list;
 }
 

@@ -18,7 +18,10 @@ double savedPercent(double zomefab, double baseline) {
 }
 
 nlohmann::json printJson(const PrintEstimate& e) {
-    nlohmann::json j = {{"parts", e.parts}, {"hours", e.hours()}, {"filament_mm3", e.filamentMm3}};
+    nlohmann::json j = {{"parts", e.parts},
+                        {"hours", e.hours()},
+                        {"filament_mm3", e.filamentMm3},
+                        {"support_mm3", e.supportMm3}};
     if (e.partVolumeMm3 > 0.0)
         j["model"] = {{"part_volume_mm3", e.partVolumeMm3},
                       {"perimeter_mm3", e.perimeterMm3},
@@ -117,6 +120,7 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<const TriMesh*>
     for (const auto& [name, infill] : cases) {
         PrintSettings settings = options.print;
         settings.infillPercent = infill;
+        settings.supports = options.countSupports;
         settings.validate();
         CostCase c;
         c.name = name;
@@ -155,6 +159,7 @@ nlohmann::json costReportToJson(const CostReport& r) {
                          {"saved_time_vs_whole_percent", c.savedTimeVsWholePercent},
                          {"saved_filament_vs_whole_percent", c.savedFilamentVsWholePercent}});
     return {{"source", estimateSourceName(r.source)},
+            {"supports_counted", o.countSupports},
             {"slicer_fallbacks", r.slicerFallbacks},
             {"pieces", r.pieceCount},
             {"baseline_parts", r.baselinePartCount},
@@ -220,7 +225,18 @@ std::string costReportMarkdown(const CostReport& r) {
               formatNumbers("%.0f", c.whole.filament.massG) + " g (" +
               formatNumbers("%.1f", c.savedFilamentVsWholePercent) + "% less)";
     }
-    md += ". Times and filament from the " + std::string(estimateSourceName(r.source)) + ".\n";
+    md += ". Times and filament from the " + std::string(estimateSourceName(r.source)) + ".";
+    if (r.options.countSupports && !r.cases.empty()) {
+        const CostCase& c = r.cases[0];
+        md += formatNumbers(
+            " Automatic supports are counted on every side, where each part's overhangs (steeper than 45°) "
+            "need "
+            "them: %.0f cm³ for the pieces, %.0f cm³ for the octree parts, %.0f cm³ for the object printed "
+            "whole.",
+            c.zomefab.print.supportMm3 / 1000.0, c.baseline.print.supportMm3 / 1000.0,
+            c.whole.print.supportMm3 / 1000.0);
+    }
+    md += "\n";
     return md;
 }
 

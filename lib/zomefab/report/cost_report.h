@@ -43,6 +43,9 @@ struct CostOptions {
     AssemblyTimeOptions assembly;
     EstimateSource source = EstimateSource::Estimator;
     SlicerOptions slicer;  ///< used when source == PrusaSlicer
+    /// Every part printed with automatic supports where its overhangs need them (pieces, octree
+    /// parts and the whole object alike): the estimator's support model or PrusaSlicer's.
+    bool countSupports = true;
 };
 
 /// One way of making the object: what it costs.
@@ -56,7 +59,7 @@ struct MakingCost {
     double totalUsd() const { return filament.costUsd + zomeUsd; }
 };
 
-/// One printed piece's print.
+/// One printed piece's print (its support in print.supportMm3).
 struct PieceCost {
     PrintEstimate print;
     FilamentUse filament;  ///< of print.filamentMm3

@@ -9,6 +9,7 @@
 
 #include "zomefab/core/error.h"
 #include "zomefab/core/fabrication.h"
+#include "zomefab/pieces/orientation.h"
 #include "zomefab/report/mesh_clip.h"
 
 namespace zomefab::report {
@@ -51,6 +52,7 @@ PrintEstimate& PrintEstimate::operator+=(const PrintEstimate& o) {
     perimeterMm3 += o.perimeterMm3;
     solidMm3 += o.solidMm3;
     infillMm3 += o.infillMm3;
+    supportMm3 += o.supportMm3;
     layers += o.layers;
     parts += o.parts;
     return *this;
@@ -126,6 +128,11 @@ PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const P
                    : 1 + size_t(std::ceil((height - s.firstLayerHeightMm) / h - 1e-9));
     e.seconds = e.perimeterMm3 * rates.perimeterSPerMm3 + e.solidMm3 * rates.solidSPerMm3 +
                 e.infillMm3 * (isSolid ? rates.solidInfillSPerMm3 : rates.sparseInfillSPerMm3);
+    if (s.supports) {
+        e.supportMm3 = rates.supportShare * pieces::estimateSupport(part, {0, 0, -1}).volumeMm3;
+        e.filamentMm3 += e.supportMm3;
+        e.seconds += e.supportMm3 * rates.supportSPerMm3;
+    }
     return e;
 }
 

@@ -94,16 +94,10 @@ json piecesJson(const RunRecord& run) {
             {"slivers_merged", run.pieces.sliversMerged}};
 }
 
-/// The share of a piece's solid support columns (Piece::supportVolumeMm3) that a slicer's sparse
-/// automatic support fills: PrusaSlicer 2.5 on the demo's plates, 1,031 cm³ of support filament
-/// against 2,205 cm³ of columns with a 50 mm² first-layer floor; with today's 25 mm², 889 against
-/// 1,754 cm³ (0.51) (docs/benchmarks.md, "Support-aware orientation").
-constexpr double kSparseSupportShare = 0.47;
-
-/// Estimated grams of support filament for @p piece, at the density of its print @p cost.
-double supportGrams(const pieces::Piece& piece, const PieceCost& cost) {
+/// Grams of support filament in a piece's print @p cost (the estimator's or the slicer's).
+double supportGrams(const PieceCost& cost) {
     const double gPerMm3 = cost.print.filamentMm3 > 0 ? cost.filament.massG / cost.print.filamentMm3 : 0.0;
-    return kSparseSupportShare * piece.supportVolumeMm3 * gPerMm3;
+    return cost.print.supportMm3 * gPerMm3;
 }
 
 json costJson(const RunRecord& run) {
@@ -116,13 +110,13 @@ json costJson(const RunRecord& run) {
                  {"support_area_mm2", piece.supportAreaMm2},
                  {"support_volume_mm3", piece.supportVolumeMm3},
                  {"brim_advised", piece.isBrimAdvised}};
-        if (!run.cost.cases.empty() && i < run.cost.cases[0].pieces.size())
-            row["support_g_estimate"] = supportGrams(piece, run.cost.cases[0].pieces[i]);
         for (const CostCase& c : run.cost.cases)
             if (i < c.pieces.size())
                 row[c.name] = {{"hours", c.pieces[i].print.hours()},
                                {"filament_mm3", c.pieces[i].print.filamentMm3},
-                               {"grams", c.pieces[i].filament.massG}};
+                               {"grams", c.pieces[i].filament.massG},
+                               {"support_mm3", c.pieces[i].print.supportMm3},
+                               {"support_grams", supportGrams(c.pieces[i])}};
         perPiece.push_back(row);
     }
     cost["per_piece"] = perPiece;
@@ -230,27 +224,32 @@ std::string perPieceMarkdown(const RunRecord& run) {
         rule += "---:|---:|";
     }
     const CostCase& first = run.cost.cases[0];
-    std::string md =
-        "\n## Per piece\n\nEach piece's print on its own (no supports counted). Overhang: the area facing "
-        "down "
-        "more than 45° from the vertical as the piece lies. Support: the estimated filament of automatic "
-        "supports, " +
-        formatNumbers("%.0f %%", 100 * kSparseSupportShare) +
-        " of the solid columns under the overhangs (PrusaSlicer on the demo: 47–51 % in all, 17–184 % per "
-        "plate). Brim: the first layer is under 4 cm².\n\n| piece | plate |" +
-        columns + " overhang cm² | support g | brim |\n|---|---:|" + rule + "---:|---:|---|\n";
+    const std::string supportNote =
+        !run.cost.options.countSupports ? "no supports counted"
+        : run.cost.source == EstimateSource::PrusaSlicer
+            ? "with PrusaSlicer's automatic supports where the overhangs need them; support: the "
+              "filament PrusaSlicer lays down as support"
+            : formatNumbers(
+                  "with automatic supports where the overhangs need them; support: the "
+                  "estimator's, %.0f %% of the solid columns under the overhangs, PrusaSlicer's "
+                  "share on the demo (47–51 %% in all, 17–184 %% per plate)",
+                  100 * run.cost.options.rates.supportShare);
+    std::string md = "\n## Per piece\n\nEach piece's print on its own, " + supportNote +
+                     ". Overhang: the area facing down more than 45° from the vertical as the piece lies. "
+                     "Brim: the first layer is under 4 cm².\n\n| piece | plate |" +
+                     columns + " overhang cm² | support g | brim |\n|---|---:|" + rule + "---:|---:|---|\n";
     double supportG = 0;
     for (size_t i = 0; i < run.pieces.pieces.size(); ++i) {
         md += "| " + pieces::pieceName(run.pieces, i) + " | " + std::to_string(plate[i]) + " |";
         for (const CostCase& c : run.cost.cases)
             md += formatNumbers(" %.1f | %.0f |", c.pieces[i].print.hours(), c.pieces[i].filament.massG);
         const pieces::Piece& piece = run.pieces.pieces[i];
-        const double grams = supportGrams(piece, first.pieces[i]);
+        const double grams = supportGrams(first.pieces[i]);
         supportG += grams;
         md += formatNumbers(" %.0f | %.0f | ", piece.supportAreaMm2 / 100.0, grams) +
               (piece.isBrimAdvised ? "yes" : "no") + " |\n";
     }
-    md += formatNumbers("\nEstimated support filament in all: %.0f g.\n", supportG);
+    md += formatNumbers("\nSupport filament in all: %.0f g.\n", supportG);
     md += "\n## Per plate (print job)\n\n" + std::to_string(run.plates.size()) +
           " print jobs, one per file in plates/.\n\n| plate | pieces |" + columns + "\n|---|---|" + rule +
           "\n";

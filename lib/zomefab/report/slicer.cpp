@@ -25,6 +25,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// The filament diameter the slicer is told (mm): the paper's 2.85 mm PLA. Only the volumes
+/// PrusaSlicer reports are used, so it sets no cost; it converts the support's length to mm³.
+constexpr double kSlicerFilamentMm = 2.85;
+
 /// Removes the scratch directory however the slicing ends.
 struct ScratchDir {
     fs::path path;
@@ -93,7 +97,7 @@ std::vector<std::string> prusaSlicerArguments(const PrintSettings& s, double bed
                                      "--nozzle-diameter",
                                      formatNumber(s.nozzleMm, 10),
                                      "--filament-diameter",
-                                     "2.85",
+                                     formatNumber(kSlicerFilamentMm, 10),
                                      "--filament-density",
                                      "1.24",
                                      "--fill-density",
@@ -114,6 +118,7 @@ std::vector<std::string> prusaSlicerArguments(const PrintSettings& s, double bed
                                      "0x0," + bed + "x0," + bed + "x" + bed + ",0x" + bed,
                                      "--max-print-height",
                                      bed};
+    if (s.supports) args.insert(args.end(), {"--support-material", "--support-material-auto"});
     // PrusaSlicer's automatic width is 1.125 × nozzle; anything else is passed explicitly.
     if (std::abs(s.extrusionWidthMm - 1.125 * s.nozzleMm) > 1e-9) {
         args.push_back("--extrusion-width");
@@ -153,6 +158,38 @@ double parseSlicerDuration(const std::string& text) {
         any = true;
     }
     return any ? seconds : -1.0;
+}
+
+double supportFilamentMm(std::istream& in) {
+    double e = 0.0, support = 0.0;
+    bool isRelative = false, isSupport = false;
+    // The E word of a move or a G92 line; NaN when it has none.
+    auto eWord = [](const std::string& line) {
+        for (size_t at = line.find(' '); at != std::string::npos; at = line.find(' ', at + 1))
+            if (at + 1 < line.size() && line[at + 1] == 'E')
+                return std::strtod(line.c_str() + at + 2, nullptr);
+        return std::nan("");
+    };
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind(";TYPE:", 0) == 0) {
+            isSupport = line.rfind(";TYPE:Support material", 0) == 0;
+        } else if (line.rfind("M83", 0) == 0) {
+            isRelative = true;
+        } else if (line.rfind("M82", 0) == 0) {
+            isRelative = false;
+        } else if (line.rfind("G92", 0) == 0) {
+            const double v = eWord(line);
+            if (!std::isnan(v)) e = v;
+        } else if (line.rfind("G1 ", 0) == 0 || line.rfind("G0 ", 0) == 0) {
+            const double v = eWord(line.substr(0, line.find(';')));
+            if (std::isnan(v)) continue;
+            const double delta = isRelative ? v : v - e;
+            if (!isRelative) e = v;
+            if (isSupport) support += delta;
+        }
+    }
+    return std::max(0.0, support);
 }
 
 PrintEstimate sliceWithPrusaSlicer(const TriMesh& part, const PrintSettings& settings,
@@ -210,6 +247,12 @@ PrintEstimate sliceWithPrusaSlicer(const TriMesh& part, const PrintSettings& set
     e.seconds = seconds;
     e.filamentMm3 = filamentCm3 * 1000.0;
     e.parts = 1;
+    if (settings.supports) {
+        std::ifstream all(gcode, std::ios::binary);
+        // The filament's section times the length.
+        const double area = 0.25 * 3.14159265358979323846 * kSlicerFilamentMm * kSlicerFilamentMm;
+        e.supportMm3 = std::min(e.filamentMm3, supportFilamentMm(all) * area);
+    }
     return e;
 }
 

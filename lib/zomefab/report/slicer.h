@@ -23,7 +23,8 @@ struct SlicerOptions {
 bool isSlicerAvailable(const std::string& executable = "prusa-slicer");
 
 /// The PrusaSlicer arguments used for @p settings (profile of ../shared/docs/print-estimates.md,
-/// a 1000 mm virtual bed so large parts are not refused), without input and output.
+/// a 1000 mm virtual bed so large parts are not refused; automatic supports when settings.supports),
+/// without input and output.
 std::vector<std::string> prusaSlicerArguments(const PrintSettings& settings, double bedMm = 1000.0);
 
 /// Slices @p part with PrusaSlicer and reads `; estimated printing time (normal mode)` and
@@ -37,5 +38,10 @@ PrintEstimate sliceWithPrusaSlicer(const TriMesh& part, const PrintSettings& set
 
 /// Seconds from PrusaSlicer's time format ("1d 2h 3m 4s", "3m 4s", "59s"); negative when malformed.
 double parseSlicerDuration(const std::string& text);
+
+/// Millimetres of filament PrusaSlicer's G-code @p in extrudes as support (the moves after
+/// ";TYPE:Support material" and ";TYPE:Support material interface"), with absolute (M82, G92 E
+/// resets) or relative (M83) extrusion. Reads line by line.
+double supportFilamentMm(std::istream& in);
 
 }  // namespace zomefab::report
