@@ -16,7 +16,7 @@ TEST_PACKAGES  := admesh draco prusa-slicer slurm-wlm munge parallel chromium
 # The Khronos glTF-Validator (npm), installed once into $(BUILD_DIR)/node; the GLB tests run it with node.
 GLTF_VALIDATOR := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: all build test demo deps test-deps clean fuzz
+.PHONY: all build test demo deps test-deps clean fuzz sweep
 
 all: build
 
@@ -36,7 +36,12 @@ build: deps $(BUILD_DIR)/CMakeCache.txt
 
 test: test-deps $(BUILD_DIR)/CMakeCache.txt
 	cmake --build $(BUILD_DIR) -j $(JOBS)
-	ctest --test-dir $(BUILD_DIR) --output-on-failure -j $(JOBS)
+	ctest --test-dir $(BUILD_DIR) --output-on-failure -j $(JOBS) -LE sweep
+
+# The size sweep at 700 mm (tools/size-sweep.sh; 200 and 400 mm run with `make test`): about half an hour
+sweep: test-deps $(BUILD_DIR)/CMakeCache.txt
+	cmake --build $(BUILD_DIR) -j $(JOBS)
+	ctest --test-dir $(BUILD_DIR) --output-on-failure -L sweep
 
 demo: build
 	./tools/demo.sh $(BUILD_DIR) $(DEMO_DIR)

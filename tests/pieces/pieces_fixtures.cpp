@@ -65,7 +65,10 @@ partition::PartitionResult piecePerCell(partition::LinearCells cells) {
     partition::PartitionResult r;
     r.cells = std::move(cells);
     r.pieces.resize(r.cells.cellCount());
-    for (size_t k = 0; k < r.pieces.size(); ++k) r.pieces[k].cells = {uint32_t(k)};
+    for (size_t k = 0; k < r.pieces.size(); ++k) {
+        r.pieces[k].cells = {uint32_t(k)};
+        r.pieces[k].fit.fits = true;  // as the partition's pieces are, for its printer (200 mm)
+    }
     return r;
 }
 

@@ -23,9 +23,11 @@ sdf::LevelSet makeSphereShell(const Vec3d& centerMm, double radiusMm, double she
 zome::Structure makeCubeLattice(double maxRadiusMm);
 
 /// A partition whose argmax cells cut space along x = @p xMm and z = @p zMm (4 cells, frame mm):
-/// for signs (sx, sz) ∈ {±1}², w = (sx, 0, sz), b = −sx·x − sz·z; one piece per cell.
+/// for signs (sx, sz) ∈ {±1}², w = (sx, 0, sz), b = −sx·x − sz·z; one piece per cell, marked as
+/// fitting the partition's printer (200 mm; makePieces tests pieces cut for another printer itself).
 partition::PartitionResult quadrantCells(double xMm, double zMm);
-/// Two cells cut by the plane n·x = d (n need not be unit): {n·x ≥ d} is cell 0; one piece each.
+/// Two cells cut by the plane n·x = d (n need not be unit): {n·x ≥ d} is cell 0; one piece each,
+/// marked as fitting (as quadrantCells).
 partition::PartitionResult halfSpaceCells(const Vec3d& n, double d);
 /// A Fabrication with the printer @p printerMm.
 Fabrication printerOf(const Vec3d& printerMm);

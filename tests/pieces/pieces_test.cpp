@@ -10,6 +10,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <set>
 
 #include "pieces_fixtures.h"
 #include "test_util.h"
@@ -19,8 +20,10 @@
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/mesh/mesh_check.h"
 #include "zomefab/pieces/detail/box_distance.h"
+#include "zomefab/pieces/detail/voxels.h"
 #include "zomefab/pieces/orientation.h"
 #include "zomefab/pieces/pieces_io.h"
+#include "zomefab/sdf/level_set_grid.h"
 #include "zomefab/zome/holes.h"
 #include "zomefab/zome/zome_system.h"
 
@@ -261,9 +264,30 @@ TEST_CASE("pieces: a cell shared by two requests and a cell no request names") {
     checkClosedAndFits(result);
 }
 
-TEST_CASE("pieces: a piece larger than the printer is an error of the partition") {
-    const partition::PartitionResult cells = halfSpaceCells({0, 0, 1}, 0.0);  // two 200 × 200 × 100 mm halves
+TEST_CASE("pieces: a piece larger than the printer is cut by planes until it fits") {
+    // Two 200 × 200 × 100 mm half-shells for a 120 mm printer: the partition's cells could not make
+    // them smaller (the cheese's case), so the pieces stage cuts each into parts that fit.
+    const partition::PartitionResult cells = halfSpaceCells({0, 0, 1}, 0.0);
+    const Fabrication fab = printerOf({120, 120, 120});
+    std::vector<std::string> messages;
+    RunContext context([&](LogLevel, const std::string& m) { messages.push_back(m); }, nullptr);
+    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells, fab, plainOptions(), context);
+    CHECK(result.pieces.size() >= 8);  // a half-shell needs two cuts at least (100 mm deep, 200 wide)
+    CHECK(result.pieces.size() <= 12);
+    checkClosedAndFits(result);
+    double total = 0;
+    for (const Piece& p : result.pieces) total += p.volumeMm3;
+    CHECK(total == doctest::Approx(shellVolume()).epsilon(0.01));
+    bool isSaid = false;
+    for (const std::string& m : messages) isSaid |= m.find("cut(s) by planes") != std::string::npos;
+    CHECK(isSaid);
+}
+
+TEST_CASE("pieces: a piece no cut can make fit the printer is an error of the partition") {
+    // Halves of at least 10 litres may not be cut (the shell holds about 0.9 L): nothing fits.
+    const partition::PartitionResult cells = halfSpaceCells({0, 0, 1}, 0.0);
     PiecesOptions o = plainOptions();
+    o.minPieceVolumeMm3 = 1e7;
     const Fabrication fab = printerOf({120, 120, 120});
     try {
         makePieces(shell(), frame(), Transform4d::identity(), cells, fab, o, RunContext::silent());
@@ -273,6 +297,38 @@ TEST_CASE("pieces: a piece larger than the printer is an error of the partition"
         CHECK(std::string(e.what()).find("in no orientation") != std::string::npos);
         CHECK(std::string(e.what()).find("partition") != std::string::npos);
     }
+}
+
+TEST_CASE("pieces: the voxels' cells, searched among each leaf's candidates, are the argmax of all cells") {
+    // 60 random cells (a partition after many repair rounds has hundreds) and one cell equal to
+    // cell 5, so ties occur: they go to the lower cell either way.
+    VoxelField field = buildField(*sdf::levelSetGrid(shell()));
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> g(0.0, 1.0);
+    partition::LinearCells model;
+    for (uint32_t k = 0; k < 60; ++k) {
+        model.w.push_back({g(rng), g(rng), g(rng)});
+        model.b.push_back(30.0 * g(rng));
+        model.classes.push_back(k);
+    }
+    model.w.push_back(model.w[5]);
+    model.b.push_back(model.b[5]);
+    model.classes.push_back(60);
+    const GridCells cells = toGridCells(model, Transform4d::identity());
+    labelCells(field, cells);
+    std::vector<double> scores(cells.count());
+    size_t active = 0, mismatches = 0;
+    std::set<uint32_t> used;
+    for (size_t s = 0; s < field.phi.size(); ++s) {
+        if (!field.isActive[s]) continue;
+        ++active;
+        mismatches += field.cell[s] != cells.owner(field.world(field.coordOf(s)), scores.data()) ? 1 : 0;
+        used.insert(field.cell[s]);
+    }
+    CHECK(active > 100000);
+    CHECK(mismatches == 0);
+    CHECK(used.size() >= 10);
+    CHECK(used.count(60) == 0);  // always tied with cell 5, which wins
 }
 
 TEST_CASE("pieces: bad inputs and options") {

@@ -19,6 +19,7 @@
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
 #include "zomefab/pieces/detail/grouping.h"
+#include "zomefab/pieces/detail/splits.h"
 #include "zomefab/pieces/detail/stages.h"
 #include "zomefab/sdf/level_set_grid.h"
 
@@ -170,7 +171,7 @@ void requireBuildable(const Pieces& pieces) {
     std::string list;
     for (size_t i = 0; i < problems.size() && i < 3; ++i) list += (i ? "; " : "") + problems[i];
     if (problems.size() > 3) list += "; and " + std::to_string(problems.size() - 3) + " more";
-    throw Error(ErrorCode::ProcessingFailed, "the pieces cannot be put on the frame: " + list);
+    throw NotBuildable("the pieces cannot be put on the frame: " + list);
 }
 
 Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
@@ -201,6 +202,14 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
     const double growMm = std::max(shellSet.info().shellMm, 4 * voxel) + 2 * voxel;
     Grouping grouping = groupPieces(field, cells, partition.pieces, affineInverse(frameToGridMm), growMm,
                                     out.options.minPieceVolumeMm3, context);
+    // What the partition's cells could not make small enough (a cell meeting the surface in one
+    // large connected patch) is cut by planes here.
+    const size_t fitCuts = splitTooLarge(grouping.pieces, grouping, field, cells, partition.pieces,
+                                         partition.printerMm == fabrication.printerMm, fabrication.printerMm,
+                                         fabrication.fitMarginMm, out.options.minPieceVolumeMm3, context);
+    if (fitCuts > 0)
+        context.info(std::to_string(fitCuts) +
+                     " cut(s) by planes made the pieces the partition left larger than the printer fit it");
     out.pieces = std::move(grouping.pieces);
     out.shellVolumeMm3 = grouping.shellVolumeMm3;
     out.outsideCellsVolumeMm3 = grouping.outsideCellsVolumeMm3;
@@ -211,6 +220,8 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
 
     planPieces(out, field, cells, grouping, *shell, frame, frameToGridMm, fabrication.wallMm, out.options,
                context);
+    // An object that cannot be built is said before the meshing, the stage's longest step.
+    if (out.options.tenons.maxPerPiece > 0) requireBuildable(out);
     context.progress("pieces", 0.35);
     context.debug("tenons and labels planned: " + formatNumber(clock.seconds(), 3) + " s");
     context.throwIfCancelled();

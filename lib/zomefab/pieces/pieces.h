@@ -155,8 +155,14 @@ public:
     double overshootMm;  ///< by how much its best orientation exceeds the printer, mm
 };
 
-/// @throw Error(ProcessingFailed) "the pieces cannot be put on the frame: ..." naming the plan's
-/// problems, when @p pieces' installation plan has any (a tool writes no such pieces).
+/// What requireBuildable throws: the installation plan has problems (exit 3).
+class NotBuildable : public Error {
+public:
+    explicit NotBuildable(const std::string& message) : Error(ErrorCode::ProcessingFailed, message) {}
+};
+
+/// @throw NotBuildable "the pieces cannot be put on the frame: ..." naming the plan's problems,
+/// when @p pieces' installation plan has any (a tool writes no such pieces).
 void requireBuildable(const Pieces& pieces);
 
 /// Cuts @p shell into printable pieces (paper §6) that fit the Fabrication's printer.
@@ -172,7 +178,8 @@ void requireBuildable(const Pieces& pieces);
 ///        Error(InvalidInput) for an empty shell, a request naming an unknown cell, mismatched
 ///        cell arrays, or a frameToGridMm that scales; PieceTooLarge when a piece fits the
 ///        printer in no orientation (the partition must cut smaller); Error(ProcessingFailed)
-///        when a piece mesh is not closed; Error(Cancelled).
+///        when a piece mesh is not closed, or (tenons on) when the installation plan has
+///        problems (requireBuildable, before any piece is meshed); Error(Cancelled).
 Pieces makePieces(const sdf::LevelSet& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
                   const partition::PartitionResult& partition, const Fabrication& fabrication,
                   const PiecesOptions& options, RunContext& context);

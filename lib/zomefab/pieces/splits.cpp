@@ -2,6 +2,8 @@
 // Re-cutting a piece no direction can mount (detail/splits.h, docs/mounting.md).
 #include "zomefab/pieces/detail/splits.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -9,6 +11,7 @@
 #include <unordered_map>
 
 #include "zomefab/mount/plan.h"
+#include "zomefab/partition/printer_fit.h"
 
 namespace zomefab::pieces::detail {
 
@@ -188,8 +191,130 @@ std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
     return best;
 }
 
+std::optional<SplitPlane> findFitSplit(const std::vector<Vec3d>& voxels, const Vec3d& printerMm,
+                                       double marginMm, const SplitSearch& search) {
+    if (voxels.size() < 2) return std::nullopt;
+    const VoxelGraph graph = voxelGraph(voxels, search);
+    std::vector<Vec3d> normals = splitDirections();
+    const partition::PrinterFit whole = partition::fitInPrinter(voxels, printerMm, marginMm);
+    normals.push_back(whole.axes[2]);  // the longest side of the best box, then the middle one
+    normals.push_back(whole.axes[1]);
+    const double cellVolume = search.voxelMm * search.voxelMm * search.voxelMm;
+    std::vector<SplitPlane> planes;
+    for (const double quantile : {0.5, 1.0 / 3.0, 2.0 / 3.0})
+        for (const Vec3d& n : normals) {
+            std::vector<double> along;
+            along.reserve(voxels.size());
+            for (const Vec3d& x : voxels) along.push_back(dot(n, x));
+            const size_t k = size_t(quantile * double(along.size() - 1));
+            std::nth_element(along.begin(), along.begin() + std::ptrdiff_t(k), along.end());
+            planes.push_back({n, along[k] + 1e-6});
+        }
+    // (halves that fit, −the larger fit ratio) per plane; (−1, 0) for planes that leave a half
+    // too small or not connected. Evaluated in parallel, chosen in plane order (deterministic).
+    std::vector<std::pair<int, double>> values(planes.size(), {-1, 0.0});
+    tbb::parallel_for(size_t(0), planes.size(), [&](size_t i) {
+        const SplitPlane& plane = planes[i];
+        std::vector<uint8_t> side(voxels.size());
+        std::array<std::vector<Vec3d>, 2> halves;
+        for (size_t v = 0; v < voxels.size(); ++v) {
+            side[v] = dot(plane.normal, voxels[v]) > plane.offsetMm;
+            halves[side[v]].push_back(voxels[v]);
+        }
+        if (double(std::min(halves[0].size(), halves[1].size())) * cellVolume < search.minVolumeMm3) return;
+        if (!isConnected(graph, side, 0) || !isConnected(graph, side, 1)) return;
+        int fitting = 0;
+        double worst = 0.0;
+        for (const std::vector<Vec3d>& half : halves) {
+            const partition::PrinterFit fit = partition::fitInPrinter(half, printerMm, marginMm);
+            fitting += fit.fits ? 1 : 0;
+            worst = std::max(worst, fit.ratio);
+        }
+        values[i] = {fitting, -worst};
+    });
+    std::optional<SplitPlane> best;
+    std::pair<int, double> bestValue{-1, 0.0};
+    for (size_t i = 0; i < planes.size(); ++i)
+        if (values[i].first >= 0 && values[i] > bestValue) best = planes[i], bestValue = values[i];
+    return best;
+}
+
+namespace {
+
+/// The cells of side @p factor voxels (from @p field's grid origin) holding an inside voxel of
+/// @p slots, as their centres (grid mm), in slot order.
+std::vector<Vec3d> coarseCells(const VoxelField& field, const std::vector<size_t>& slots, int factor) {
+    std::vector<Vec3d> out;
+    std::unordered_map<int64_t, char> seen;
+    for (size_t s : slots) {
+        if (!field.isInside(s)) continue;
+        const Coord c = field.coordOf(s);
+        const int64_t i = int64_t(std::floor(double(c.x()) / factor)), j = int64_t(std::floor(double(c.y()) / factor)),
+                      k = int64_t(std::floor(double(c.z()) / factor));
+        if (!seen.emplace(((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF), 1).second) continue;
+        const double half = 0.5 * double(factor - 1);
+        const Vec3d corner = field.world(Coord(int(i * factor), int(j * factor), int(k * factor)));
+        out.push_back(add(corner, scale(Vec3d{1, 1, 1}, half * field.voxelMm)));
+    }
+    return out;
+}
+
+}  // namespace
+
+size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field, const GridCells& cells,
+                     const std::vector<partition::Piece>& requests, bool isRequestFitTrusted,
+                     const Vec3d& printerMm, double marginMm, double minVolumeMm3, const RunContext& context) {
+    constexpr double kMaxCells = 500000.0;
+    // Each piece's band and inside slots, gathered once (a scan of the whole field per cut is slow
+    // at 700 mm).
+    std::vector<std::vector<size_t>> slotsOf(pieces.size());
+    for (size_t s = 0; s < field.phi.size(); ++s)
+        if (field.isActive[s] && field.owner[s] != kNone && field.owner[s] < pieces.size())
+            slotsOf[field.owner[s]].push_back(s);
+    size_t cuts = 0;
+    std::vector<uint32_t> queue(pieces.size());
+    for (uint32_t p = 0; p < pieces.size(); ++p) queue[p] = p;
+    // What the partition fitted to this printer stays as it is (its surface test is the one the
+    // cuts were made for); a piece with a request it could not fit is tested here.
+    auto isFitted = [&](uint32_t p) {
+        if (!isRequestFitTrusted) return false;
+        for (uint32_t r : pieces[p].requests)
+            if (r >= requests.size() || !requests[r].fit.fits) return false;
+        return !pieces[p].requests.empty();
+    };
+    for (size_t q = 0; q < queue.size() && cuts < 4 * pieces.size() + 64; ++q) {
+        context.throwIfCancelled();
+        const uint32_t p = queue[q];
+        if (isFitted(p)) continue;
+        size_t inside = 0;
+        for (size_t s : slotsOf[p]) inside += field.isInside(s) ? 1 : 0;
+        const int factor = std::max({1, int(std::ceil(2.0 / field.voxelMm - 1e-9)),
+                                     int(std::ceil(std::cbrt(double(inside) / kMaxCells)))});
+        SplitSearch search;
+        search.voxelMm = factor * field.voxelMm;
+        search.originMm = field.world(Coord(0, 0, 0));
+        search.minVolumeMm3 = minVolumeMm3;
+        // A cell's centre lies up to half its diagonal inside the piece's true extent.
+        const double margin = marginMm + 0.5 * std::sqrt(3.0) * search.voxelMm;
+        const std::vector<Vec3d> points = coarseCells(field, slotsOf[p], factor);
+        if (partition::fitInPrinter(points, printerMm, margin).fits) continue;
+        const std::optional<SplitPlane> plane = findFitSplit(points, printerMm, margin, search);
+        if (!plane) continue;
+        std::vector<size_t> otherSlots;
+        const uint32_t other = splitPiece(pieces, grouping.cellSets, field, p, *plane, &slotsOf[p], &otherSlots);
+        slotsOf.push_back(std::move(otherSlots));
+        context.detail("piece " + std::to_string(p) + " is larger than the printer in every orientation: cut in two (" +
+                       std::to_string(p) + " and " + std::to_string(other) + ")");
+        ++cuts;
+        queue.push_back(p);
+        queue.push_back(other);
+    }
+    if (cuts > 0) grouping.faces = faceContacts(field, cells, grouping.cellSets, pieces);
+    return cuts;
+}
+
 uint32_t splitPiece(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field, uint32_t p,
-                    const SplitPlane& plane) {
+                    const SplitPlane& plane, std::vector<size_t>* slots, std::vector<size_t>* newSlots) {
     const uint32_t q = uint32_t(pieces.size());
     Piece half;
     half.id = q;
@@ -202,10 +327,18 @@ uint32_t splitPiece(std::vector<Piece>& pieces, std::vector<CellSet>& sets, Voxe
     sets.push_back(other);
     const double voxelVolume = field.voxelMm * field.voxelMm * field.voxelMm;
     pieces[p].shellVolumeMm3 = 0.0;
-    for (size_t s = 0; s < field.phi.size(); ++s) {
-        if (!field.isActive[s] || field.owner[s] != p) continue;
+    auto visit = [&](size_t s) {
         if (dot(plane.normal, field.world(field.coordOf(s))) > plane.offsetMm) field.owner[s] = q;
         if (field.isInside(s)) (field.owner[s] == q ? pieces[q] : pieces[p]).shellVolumeMm3 += voxelVolume;
+    };
+    if (slots) {
+        for (size_t s : *slots) visit(s);
+        std::vector<size_t> kept;
+        for (size_t s : *slots) (field.owner[s] == q ? *newSlots : kept).push_back(s);
+        *slots = std::move(kept);
+    } else {
+        for (size_t s = 0; s < field.phi.size(); ++s)
+            if (field.isActive[s] && field.owner[s] == p) visit(s);
     }
     return q;
 }

@@ -107,15 +107,43 @@ VoxelField buildField(const FloatGrid& shell) {
 void labelCells(VoxelField& field, const GridCells& cells) {
     const size_t cellCount = cells.count();
     field.cell.assign(field.phi.size(), kNone);
+    // Per leaf, only the cells that can be the argmax somewhere in its box: over the box a score
+    // varies by at most Σ|w_a|·h around its value at the centre, so a cell whose highest score there
+    // is below another's lowest is never the argmax (strictly below: ties are unchanged). With the
+    // hundreds of cells of a partition that needed many repair rounds this is what keeps the
+    // labelling from taking minutes at 700 mm.
+    const double halfMm = 3.5 * field.voxelMm;  // the leaf's 8 voxel centres span 7 voxels
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, field.leafOrigin.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-            std::vector<double> scores(cellCount);
-            for (size_t leaf = r.begin(); leaf < r.end(); ++leaf)
+            std::vector<double> centre(cellCount), reach(cellCount);
+            std::vector<uint32_t> candidates;
+            for (size_t leaf = r.begin(); leaf < r.end(); ++leaf) {
+                const Coord& o = field.leafOrigin[leaf];
+                const Vec3d c = add(field.world(o), {halfMm, halfMm, halfMm});
+                double floor = -std::numeric_limits<double>::infinity();
+                for (size_t k = 0; k < cellCount; ++k) {
+                    centre[k] = cells.score(k, c);
+                    reach[k] = (std::abs(cells.w[k][0]) + std::abs(cells.w[k][1]) + std::abs(cells.w[k][2])) * halfMm;
+                    floor = std::max(floor, centre[k] - reach[k]);
+                }
+                candidates.clear();
+                for (size_t k = 0; k < cellCount; ++k) {
+                    const double slack = 1e-9 * (std::abs(centre[k]) + reach[k] + std::abs(floor) + 1.0);
+                    if (centre[k] + reach[k] + slack >= floor) candidates.push_back(uint32_t(k));
+                }
                 for (uint32_t off = 0; off < kLeafSize; ++off) {
                     const size_t s = leaf * kLeafSize + off;
-                    if (field.isActive[s])
-                        field.cell[s] = cells.owner(field.world(field.coordOf(s)), scores.data());
+                    if (!field.isActive[s]) continue;
+                    const Vec3d x = field.world(field.coordOf(s));
+                    uint32_t best = candidates.front();
+                    double bestScore = cells.score(best, x);
+                    for (size_t i = 1; i < candidates.size(); ++i) {
+                        const double score = cells.score(candidates[i], x);
+                        if (score > bestScore) best = candidates[i], bestScore = score;
+                    }
+                    field.cell[s] = best;
                 }
+            }
         });
 }
 

@@ -43,10 +43,34 @@ std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
                                     const std::vector<const TenonCandidate*>& candidates,
                                     const FrameSweeps& sweeps, const SplitSearch& search);
 
+/// The plane that cuts a piece too large for the printer (@p voxels: its inside voxels' centres,
+/// or the centres of coarser cells of side @p search.voxelMm) into two connected halves, the
+/// larger as small as can be: both halves fitting @p printerMm (each box side grown by
+/// @p marginMm) first, then the smaller of the two halves' fit ratios. The same 13 directions as
+/// findSplit and the printer-fit box's own axes, through the median and the thirds. Empty when no
+/// plane leaves two connected halves of at least search.minVolumeMm3.
+std::optional<SplitPlane> findFitSplit(const std::vector<Vec3d>& voxels, const Vec3d& printerMm,
+                                       double marginMm, const SplitSearch& search);
+
+/// Cuts every piece that holds a partition piece (of @p requests) the partition could not fit and
+/// whose inside voxels fit @p printerMm in no orientation (each box side grown by @p marginMm)
+/// along findFitSplit's planes until all fit: the partition could not separate them with its
+/// cells (a cell that meets the surface in one large connected patch, seen on a cube with
+/// cavities). Pieces of fitted requests only are left alone when @p isRequestFitTrusted (the
+/// partition was cut for this printer); otherwise every piece is tested. The search runs on cells of about 2 mm or coarser (at most ~500,000 per
+/// piece). Recomputes @p grouping's faces when it cut. Returns how many cuts; pieces no plane
+/// helps stay as they are (finishPiece then says so).
+size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field, const GridCells& cells,
+                     const std::vector<partition::Piece>& requests, bool isRequestFitTrusted,
+                     const Vec3d& printerMm, double marginMm, double minVolumeMm3, const RunContext& context);
+
 /// Cuts piece @p p along @p plane: its voxels beyond the plane (inside and band) go to a new piece
 /// with the next id, its cell set with the other half-space; shell volumes recounted. Returns the
-/// new piece's id. The caller recomputes the face contacts (faceContacts).
+/// new piece's id. The caller recomputes the face contacts (faceContacts). With @p slots (the
+/// piece's active slots, band and inside) only those are visited, and they are divided: @p slots
+/// keeps the piece's, @p newSlots receives the new piece's.
 uint32_t splitPiece(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field, uint32_t p,
-                    const SplitPlane& plane);
+                    const SplitPlane& plane, std::vector<size_t>* slots = nullptr,
+                    std::vector<size_t>* newSlots = nullptr);
 
 }  // namespace zomefab::pieces::detail
