@@ -44,11 +44,11 @@ std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
                                     const FrameSweeps& sweeps, const SplitSearch& search);
 
 /// The plane that cuts a piece too large for the printer (@p voxels: its inside voxels' centres,
-/// or the centres of coarser cells of side @p search.voxelMm) into two connected halves, the
-/// larger as small as can be: both halves fitting @p printerMm (each box side grown by
-/// @p marginMm) first, then the smaller of the two halves' fit ratios. The same 13 directions as
-/// findSplit and the printer-fit box's own axes, through the median and the thirds. Empty when no
-/// plane leaves two connected halves of at least search.minVolumeMm3.
+/// or the centres of coarser cells of side @p search.voxelMm) into two connected halves: planes
+/// with both halves fitting @p printerMm (each box side grown by @p marginMm) first, then the one
+/// whose worse half has the lowest fit ratio. The same 13 directions as findSplit and the
+/// printer-fit box's two longest axes, through the median and the thirds. Empty when no plane
+/// leaves two connected halves of at least search.minVolumeMm3.
 std::optional<SplitPlane> findFitSplit(const std::vector<Vec3d>& voxels, const Vec3d& printerMm,
                                        double marginMm, const SplitSearch& search);
 
