@@ -35,6 +35,12 @@ std::vector<Vec3d> splitDirections() {
     return out;
 }
 
+/// A cell index (i, j, k) packed into one key (21 bits each, wrapping: the grids here span far
+/// fewer than 2^21 cells).
+int64_t packCell(int64_t i, int64_t j, int64_t k) {
+    return ((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF);
+}
+
 /// The piece's voxels with their 6-neighbours (indices, kNone where the neighbour is not in it).
 struct VoxelGraph {
     const std::vector<Vec3d>* voxels = nullptr;
@@ -46,7 +52,7 @@ VoxelGraph voxelGraph(const std::vector<Vec3d>& voxels, const SplitSearch& s) {
         const int64_t i = std::llround((x[0] - s.originMm[0]) / s.voxelMm) + dx;
         const int64_t j = std::llround((x[1] - s.originMm[1]) / s.voxelMm) + dy;
         const int64_t k = std::llround((x[2] - s.originMm[2]) / s.voxelMm) + dz;
-        return ((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF);
+        return packCell(i, j, k);
     };
     std::unordered_map<int64_t, uint32_t> index;
     index.reserve(voxels.size() * 2);
@@ -191,12 +197,11 @@ std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
     return best;
 }
 
-std::optional<SplitPlane> findFitSplit(const std::vector<Vec3d>& voxels, const Vec3d& printerMm,
-                                       double marginMm, const SplitSearch& search) {
+std::optional<SplitPlane> findFitSplit(const std::vector<Vec3d>& voxels, const partition::PrinterFit& whole,
+                                       const Vec3d& printerMm, double marginMm, const SplitSearch& search) {
     if (voxels.size() < 2) return std::nullopt;
     const VoxelGraph graph = voxelGraph(voxels, search);
     std::vector<Vec3d> normals = splitDirections();
-    const partition::PrinterFit whole = partition::fitInPrinter(voxels, printerMm, marginMm);
     normals.push_back(whole.axes[2]);  // the longest side of the best box, then the middle one
     normals.push_back(whole.axes[1]);
     const double cellVolume = search.voxelMm * search.voxelMm * search.voxelMm;
@@ -251,7 +256,7 @@ std::vector<Vec3d> coarseCells(const VoxelField& field, const std::vector<size_t
         const Coord c = field.coordOf(s);
         const int64_t i = int64_t(std::floor(double(c.x()) / factor)), j = int64_t(std::floor(double(c.y()) / factor)),
                       k = int64_t(std::floor(double(c.z()) / factor));
-        if (!seen.emplace(((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF), 1).second) continue;
+        if (!seen.emplace(packCell(i, j, k), 1).second) continue;
         const double half = 0.5 * double(factor - 1);
         const Vec3d corner = field.world(Coord(int(i * factor), int(j * factor), int(k * factor)));
         out.push_back(add(corner, scale(Vec3d{1, 1, 1}, half * field.voxelMm)));
@@ -297,8 +302,9 @@ size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField&
         // A cell's centre lies up to half its diagonal inside the piece's true extent.
         const double margin = marginMm + 0.5 * std::sqrt(3.0) * search.voxelMm;
         const std::vector<Vec3d> points = coarseCells(field, slotsOf[p], factor);
-        if (partition::fitInPrinter(points, printerMm, margin).fits) continue;
-        const std::optional<SplitPlane> plane = findFitSplit(points, printerMm, margin, search);
+        const partition::PrinterFit whole = partition::fitInPrinter(points, printerMm, margin);
+        if (whole.fits) continue;
+        const std::optional<SplitPlane> plane = findFitSplit(points, whole, printerMm, margin, search);
         if (!plane) continue;
         std::vector<size_t> otherSlots;
         const uint32_t other = splitPiece(pieces, grouping.cellSets, field, p, *plane, &slotsOf[p], &otherSlots);

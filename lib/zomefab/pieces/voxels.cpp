@@ -113,9 +113,12 @@ void labelCells(VoxelField& field, const GridCells& cells) {
     // hundreds of cells of a partition that needed many repair rounds this is what keeps the
     // labelling from taking minutes at 700 mm.
     const double halfMm = 3.5 * field.voxelMm;  // the leaf's 8 voxel centres span 7 voxels
+    std::vector<double> reach(cellCount);          // Σ|w_a|·h, the same for every leaf
+    for (size_t k = 0; k < cellCount; ++k)
+        reach[k] = (std::abs(cells.w[k][0]) + std::abs(cells.w[k][1]) + std::abs(cells.w[k][2])) * halfMm;
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, field.leafOrigin.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-            std::vector<double> centre(cellCount), reach(cellCount);
+            std::vector<double> centre(cellCount);
             std::vector<uint32_t> candidates;
             for (size_t leaf = r.begin(); leaf < r.end(); ++leaf) {
                 const Coord& o = field.leafOrigin[leaf];
@@ -123,7 +126,6 @@ void labelCells(VoxelField& field, const GridCells& cells) {
                 double floor = -std::numeric_limits<double>::infinity();
                 for (size_t k = 0; k < cellCount; ++k) {
                     centre[k] = cells.score(k, c);
-                    reach[k] = (std::abs(cells.w[k][0]) + std::abs(cells.w[k][1]) + std::abs(cells.w[k][2])) * halfMm;
                     floor = std::max(floor, centre[k] - reach[k]);
                 }
                 candidates.clear();

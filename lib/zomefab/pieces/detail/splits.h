@@ -10,6 +10,7 @@
 #include <optional>
 #include <vector>
 
+#include "zomefab/partition/printer_fit.h"
 #include "zomefab/pieces/detail/grouping.h"
 #include "zomefab/pieces/detail/mounting.h"
 #include "zomefab/pieces/detail/voxels.h"
@@ -48,9 +49,10 @@ std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
 /// with both halves fitting @p printerMm (each box side grown by @p marginMm) first, then the one
 /// whose worse half has the lowest fit ratio. The same 13 directions as findSplit and the
 /// printer-fit box's two longest axes, through the median and the thirds. Empty when no plane
-/// leaves two connected halves of at least search.minVolumeMm3.
-std::optional<SplitPlane> findFitSplit(const std::vector<Vec3d>& voxels, const Vec3d& printerMm,
-                                       double marginMm, const SplitSearch& search);
+/// leaves two connected halves of at least search.minVolumeMm3. @p whole: the voxels' own fit
+/// (fitInPrinter with the same printer and margin), which the caller has already tested.
+std::optional<SplitPlane> findFitSplit(const std::vector<Vec3d>& voxels, const partition::PrinterFit& whole,
+                                       const Vec3d& printerMm, double marginMm, const SplitSearch& search);
 
 /// Cuts every piece that holds a partition piece (of @p requests) the partition could not fit and
 /// whose inside voxels fit @p printerMm in no orientation (each box side grown by @p marginMm)
