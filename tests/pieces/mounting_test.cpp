@@ -6,6 +6,8 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <string>
+#include <vector>
 
 #include "zomefab/core/run_context.h"
 #include "zomefab/pieces/detail/mounting.h"
@@ -145,4 +147,33 @@ TEST_CASE("mounting: a piece glued on goes on before its only host leaves") {
     CHECK(r.stuck.empty());
     CHECK(r.order == std::vector<uint32_t>{0, 1, 2});
     CHECK(r.gluedOn == std::vector<std::pair<uint32_t, uint32_t>>{{0, 1}, {1, 2}});
+}
+
+TEST_CASE("mounting: every pair of bodies in each other's way is glued into one in the same round") {
+    // Two pairs far apart, each of two slabs whose only directions run into each other (A up into
+    // B, B down into A): no order exists until each pair is glued; glued, each pair goes on along
+    // either direction (no frame: every path is free). Both pairs are glued in one round, and the
+    // bodies left after gluing keep their pieces (a self-move once emptied the first body's list).
+    PlannerInput input;
+    input.pieces = {slab(0, 0, 10, 0, 5), slab(1, 0, 10, 20, 25), slab(2, 100, 110, 0, 5),
+                    slab(3, 100, 110, 20, 25)};
+    input.candidatesByHole = {{{kUp, {2, 1.0}}}, {{kDown, {2, 1.0}}}, {{kUp, {2, 1.0}}}, {{kDown, {2, 1.0}}}};
+    const FaceContacts faces = {{{0, 1}, {CutContact{{0, 0, 1}, 121}}}, {{2, 3}, {CutContact{{0, 0, 1}, 121}}}};
+    const zome::Structure noFrame;
+    Box3d bounds;
+    for (const MountBody& b : input.pieces) bounds.expand(b.bounds.min), bounds.expand(b.bounds.max);
+    const FrameSweeps sweeps(noFrame, Transform4d::identity(), bounds, 1.0, 0.5);
+    std::vector<std::string> messages;
+    const RunContext context([&](LogLevel, const std::string& m) { messages.push_back(m); }, nullptr);
+    const mount::InstallationPlan plan = planMounting(input, sweeps, faces, 1.0, {kUp, kDown}, 2, context);
+    CHECK(plan.isBuildable());
+    CHECK(plan.glued == std::vector<std::pair<uint32_t, uint32_t>>{{0, 1}, {2, 3}});
+    REQUIRE(plan.steps.size() == 2);
+    std::vector<uint32_t> mounted;
+    for (const mount::MountStep& step : plan.steps) mounted.insert(mounted.end(), step.pieces.begin(), step.pieces.end());
+    std::sort(mounted.begin(), mounted.end());
+    CHECK(mounted == std::vector<uint32_t>{0, 1, 2, 3});
+    CHECK(std::count_if(messages.begin(), messages.end(), [](const std::string& m) {
+              return m.find("2 pairs glued into one") != std::string::npos;
+          }) == 1);
 }

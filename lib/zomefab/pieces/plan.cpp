@@ -162,6 +162,7 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
                              opt.mount.frameMarginMm);
     std::vector<TenonCandidate> candidates;
     std::set<std::pair<zome::BallId, int>> lost;  // candidates other pieces' tenons took
+    size_t lastUnplaced = SIZE_MAX;
     for (int round = 0;; ++round) {
         const Stopwatch clock;
         candidates = findTenonCandidates(frame, frameToGridMm, probe, opt.tenons);
@@ -176,6 +177,17 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         context.debug("mounting: plan " + std::to_string(round) + " in " + formatNumber(clock.seconds(), 3) +
                       " s");
         if (out.plan.isBuildable() || round == kRecutRounds) break;
+        // Re-cutting that places no more pieces is given up: on the cheese at 700 mm the halves
+        // of 116 pieces lining its tunnels were as stuck as the pieces (110 stuck bodies, then 225).
+        const size_t unplaced = size_t(
+            std::count(out.plan.holeOfPiece.begin(), out.plan.holeOfPiece.end(), -1));
+        if (unplaced >= lastUnplaced) {
+            context.detail("mounting: re-cutting placed no more pieces (" + std::to_string(unplaced) +
+                           " without a direction, " + std::to_string(lastUnplaced) +
+                           " before): no more rounds");
+            break;
+        }
+        lastUnplaced = unplaced;
         const size_t cut = recutBlocked(out, field, cells, grouping, input, candidates, sweeps, opt, context);
         context.debug("mounting: re-cut " + std::to_string(cut) + " in " + formatNumber(clock.seconds(), 3) +
                       " s");
