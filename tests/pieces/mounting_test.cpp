@@ -158,7 +158,8 @@ TEST_CASE("mounting: every pair of bodies in each other's way is glued into one 
     input.pieces = {slab(0, 0, 10, 0, 5), slab(1, 0, 10, 20, 25), slab(2, 100, 110, 0, 5),
                     slab(3, 100, 110, 20, 25)};
     input.candidatesByHole = {{{kUp, {2, 1.0}}}, {{kDown, {2, 1.0}}}, {{kUp, {2, 1.0}}}, {{kDown, {2, 1.0}}}};
-    const FaceContacts faces = {{{0, 1}, {CutContact{{0, 0, 1}, 121}}}, {{2, 3}, {CutContact{{0, 0, 1}, 121}}}};
+    const FaceContacts faces = {{{0, 1}, {CutContact{{0, 0, 1}, 121}}},
+                                {{2, 3}, {CutContact{{0, 0, 1}, 121}}}};
     const zome::Structure noFrame;
     Box3d bounds;
     for (const MountBody& b : input.pieces) bounds.expand(b.bounds.min), bounds.expand(b.bounds.max);
@@ -170,7 +171,8 @@ TEST_CASE("mounting: every pair of bodies in each other's way is glued into one 
     CHECK(plan.glued == std::vector<std::pair<uint32_t, uint32_t>>{{0, 1}, {2, 3}});
     REQUIRE(plan.steps.size() == 2);
     std::vector<uint32_t> mounted;
-    for (const mount::MountStep& step : plan.steps) mounted.insert(mounted.end(), step.pieces.begin(), step.pieces.end());
+    for (const mount::MountStep& step : plan.steps)
+        mounted.insert(mounted.end(), step.pieces.begin(), step.pieces.end());
     std::sort(mounted.begin(), mounted.end());
     CHECK(mounted == std::vector<uint32_t>{0, 1, 2, 3});
     CHECK(std::count_if(messages.begin(), messages.end(), [](const std::string& m) {

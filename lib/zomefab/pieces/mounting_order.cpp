@@ -44,10 +44,9 @@ bool shadowsMeet(const Box3d& moving, const Box3d& still, const Vec3d& d) {
 
 /// Does @p moving, pushed off along @p d, run into @p still's voxels? A voxel of tolerance: two
 /// neighbours' voxels across their cut face are a voxel apart (the face itself is tested exactly
-/// by facesAllow).
+/// by facesAllow). Only asked where shadowsMeet (blockersOf tests that first, before its cache).
 bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, double voxelMm,
                bool isTouching) {
-    if (!shadowsMeet(moving.bounds, still.bounds, d)) return false;
     Box3d bounds = moving.bounds;
     bounds.expand(still.bounds.min), bounds.expand(still.bounds.max);
     const mount::SweepAxes axes(d);
@@ -139,8 +138,8 @@ struct Bodies {
 /// (one pair per call took a planning round per pair: the cheese at 700 mm had 135 stuck bodies and
 /// a round of 20 s). @p noFreeUnion remembers the unions found with no free direction. Returns how
 /// many pairs were glued.
-size_t glueStuck(Bodies& bodies, const Disassembly& parts, const PlannerInput& input, const FrameSweeps& sweeps,
-                 const FaceContacts& faces, double voxelMm, int maxPerPiece,
+size_t glueStuck(Bodies& bodies, const Disassembly& parts, const PlannerInput& input,
+                 const FrameSweeps& sweeps, const FaceContacts& faces, double voxelMm, int maxPerPiece,
                  std::set<std::vector<uint32_t>>& noFreeUnion) {
     auto blocks = [&](size_t k, uint32_t other) {
         const std::vector<uint32_t>& list = parts.stuckBlockers[k];
@@ -317,7 +316,8 @@ const std::vector<uint32_t>& blockersOf(std::vector<BodyState>& state, uint32_t 
             continue;
         }
         touching[a] = isTouching;
-        if (!shadowsMeet(bodies[b].bounds, bodies[a].bounds, d)) continue;  // cheaper than the cache
+        // Boxes whose shadows cannot meet never collide: tested before the cache, which is dearer.
+        if (!shadowsMeet(bodies[b].bounds, bodies[a].bounds, d)) continue;
         const auto it = cache.find(std::make_tuple(bodies[b].pieces, bodies[a].pieces, hole));
         if (it != cache.end())
             isBlocked[a] = it->second;
@@ -495,7 +495,8 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
             for (uint32_t o : parts.stuckBlockers[k]) in += " " + bodyName(bodies.list[o]);
             context.debug("mounting: stuck: " + bodyName(bodies.list[parts.stuck[k]]) + ", in its way:" + in);
         }
-        const size_t glued = glueStuck(bodies, parts, input, sweeps, faces, voxelMm, maxPerPiece, noFreeUnion);
+        const size_t glued =
+            glueStuck(bodies, parts, input, sweeps, faces, voxelMm, maxPerPiece, noFreeUnion);
         if (glued == 0) break;
         glues += glued;
         context.debug("mounting: " + std::to_string(parts.stuck.size()) + " bodies stuck, " +

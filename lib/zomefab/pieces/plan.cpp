@@ -179,8 +179,8 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         if (out.plan.isBuildable() || round == kRecutRounds) break;
         // Re-cutting that places no more pieces is given up: on the cheese at 700 mm the halves
         // of 116 pieces lining its tunnels were as stuck as the pieces (110 stuck bodies, then 225).
-        const size_t unplaced = size_t(
-            std::count(out.plan.holeOfPiece.begin(), out.plan.holeOfPiece.end(), -1));
+        const size_t unplaced =
+            size_t(std::count(out.plan.holeOfPiece.begin(), out.plan.holeOfPiece.end(), -1));
         if (unplaced >= lastUnplaced) {
             context.detail("mounting: re-cutting placed no more pieces (" + std::to_string(unplaced) +
                            " without a direction, " + std::to_string(lastUnplaced) +

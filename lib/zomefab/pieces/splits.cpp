@@ -254,7 +254,8 @@ std::vector<Vec3d> coarseCells(const VoxelField& field, const std::vector<size_t
     for (size_t s : slots) {
         if (!field.isInside(s)) continue;
         const Coord c = field.coordOf(s);
-        const int64_t i = int64_t(std::floor(double(c.x()) / factor)), j = int64_t(std::floor(double(c.y()) / factor)),
+        const int64_t i = int64_t(std::floor(double(c.x()) / factor)),
+                      j = int64_t(std::floor(double(c.y()) / factor)),
                       k = int64_t(std::floor(double(c.z()) / factor));
         if (!seen.emplace(packCell(i, j, k), 1).second) continue;
         const double half = 0.5 * double(factor - 1);
@@ -266,9 +267,10 @@ std::vector<Vec3d> coarseCells(const VoxelField& field, const std::vector<size_t
 
 }  // namespace
 
-size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field, const GridCells& cells,
-                     const std::vector<partition::Piece>& requests, bool isRequestFitTrusted,
-                     const Vec3d& printerMm, double marginMm, double minVolumeMm3, const RunContext& context) {
+size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
+                     const GridCells& cells, const std::vector<partition::Piece>& requests,
+                     bool isRequestFitTrusted, const Vec3d& printerMm, double marginMm, double minVolumeMm3,
+                     const RunContext& context) {
     constexpr double kMaxCells = 500000.0;
     // Each piece's band and inside slots, gathered once (a scan of the whole field per cut is slow
     // at 700 mm).
@@ -307,10 +309,12 @@ size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField&
         const std::optional<SplitPlane> plane = findFitSplit(points, whole, printerMm, margin, search);
         if (!plane) continue;
         std::vector<size_t> otherSlots;
-        const uint32_t other = splitPiece(pieces, grouping.cellSets, field, p, *plane, &slotsOf[p], &otherSlots);
+        const uint32_t other =
+            splitPiece(pieces, grouping.cellSets, field, p, *plane, &slotsOf[p], &otherSlots);
         slotsOf.push_back(std::move(otherSlots));
-        context.detail("piece " + std::to_string(p) + " is larger than the printer in every orientation: cut in two (" +
-                       std::to_string(p) + " and " + std::to_string(other) + ")");
+        context.detail("piece " + std::to_string(p) +
+                       " is larger than the printer in every orientation: cut in two (" + std::to_string(p) +
+                       " and " + std::to_string(other) + ")");
         ++cuts;
         queue.push_back(p);
         queue.push_back(other);

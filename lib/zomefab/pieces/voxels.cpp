@@ -113,7 +113,7 @@ void labelCells(VoxelField& field, const GridCells& cells) {
     // hundreds of cells of a partition that needed many repair rounds this is what keeps the
     // labelling from taking minutes at 700 mm.
     const double halfMm = 3.5 * field.voxelMm;  // the leaf's 8 voxel centres span 7 voxels
-    std::vector<double> reach(cellCount);          // Σ|w_a|·h, the same for every leaf
+    std::vector<double> reach(cellCount);       // Σ|w_a|·h, the same for every leaf
     for (size_t k = 0; k < cellCount; ++k)
         reach[k] = (std::abs(cells.w[k][0]) + std::abs(cells.w[k][1]) + std::abs(cells.w[k][2])) * halfMm;
     tbb::parallel_for(

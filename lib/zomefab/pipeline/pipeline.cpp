@@ -116,11 +116,12 @@ void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunConte
             // A frame of a few balls in a row (no B0 cube fits) reaches little of a large surface:
             // say that this, not the plan, is why.
             if (run.frame.lattice.cubes > 0) throw;
-            throw pieces::NotBuildable(
-                e.message() + " (the object is thinner than one B0 cube and its " +
-                formatNumbers("%.0f", run.fabrication.frameDMinMm()) + " mm clearance, so its frame is only " +
-                std::to_string(run.frame.structure.ballCount()) + " balls and " +
-                std::to_string(run.frame.structure.strutCount()) + " struts: too few to hold every piece)");
+            throw pieces::NotBuildable(e.message() + " (the object is thinner than one B0 cube and its " +
+                                       formatNumbers("%.0f", run.fabrication.frameDMinMm()) +
+                                       " mm clearance, so its frame is only " +
+                                       std::to_string(run.frame.structure.ballCount()) + " balls and " +
+                                       std::to_string(run.frame.structure.strutCount()) +
+                                       " struts: too few to hold every piece)");
         } catch (const pieces::PieceTooLarge& e) {
             if (refit == kMaxRefits) throw;
             const double before = run.fabrication.fitMarginMm;

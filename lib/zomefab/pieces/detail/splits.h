@@ -59,12 +59,13 @@ std::optional<SplitPlane> findFitSplit(const std::vector<Vec3d>& voxels, const p
 /// along findFitSplit's planes until all fit: the partition could not separate them with its
 /// cells (a cell that meets the surface in one large connected patch, seen on a cube with
 /// cavities). Pieces of fitted requests only are left alone when @p isRequestFitTrusted (the
-/// partition was cut for this printer); otherwise every piece is tested. The search runs on cells of about 2 mm or coarser (at most ~500,000 per
-/// piece). Recomputes @p grouping's faces when it cut. Returns how many cuts; pieces no plane
-/// helps stay as they are (finishPiece then says so).
-size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field, const GridCells& cells,
-                     const std::vector<partition::Piece>& requests, bool isRequestFitTrusted,
-                     const Vec3d& printerMm, double marginMm, double minVolumeMm3, const RunContext& context);
+/// partition was cut for this printer); otherwise every piece is tested. The search runs on cells
+/// of about 2 mm or coarser (at most ~500,000 per piece). Recomputes @p grouping's faces when it
+/// cut. Returns how many cuts; pieces no plane helps stay as they are (finishPiece then says so).
+size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
+                     const GridCells& cells, const std::vector<partition::Piece>& requests,
+                     bool isRequestFitTrusted, const Vec3d& printerMm, double marginMm, double minVolumeMm3,
+                     const RunContext& context);
 
 /// Cuts piece @p p along @p plane: its voxels beyond the plane (inside and band) go to a new piece
 /// with the next id, its cell set with the other half-space; shell volumes recounted. Returns the
