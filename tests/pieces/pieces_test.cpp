@@ -20,6 +20,8 @@
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/mesh/mesh_check.h"
 #include "zomefab/pieces/detail/box_distance.h"
+#include "zomefab/pieces/detail/grouping.h"
+#include "zomefab/pieces/detail/merges.h"
 #include "zomefab/pieces/detail/voxels.h"
 #include "zomefab/pieces/orientation.h"
 #include "zomefab/pieces/pieces_io.h"
@@ -424,7 +426,9 @@ TEST_CASE("pieces: a frame rotated about the vertical and shifted") {
     o.tenons.maxTiltDeg = 35;
     const Pieces result =
         makePieces(shell(), small, frameToGrid, cells, Fabrication{}, o, RunContext::silent());
-    REQUIRE(result.pieces.size() == 4);
+    // A quadrant too few pegs hold is printed as one with a neighbour (docs/mounting.md, "Merged
+    // pieces"): the merged piece holds both quadrants' cells, which the point test below checks.
+    REQUIRE(result.pieces.size() + result.mergedPieces == 4);
     checkClosedAndFits(result);
     size_t total = 0;
     for (const Piece& p : result.pieces)
@@ -460,7 +464,8 @@ TEST_CASE("pieces: a frame rotated about the vertical and shifted") {
         if (isNearTenon) continue;
         for (size_t k = 0; k < meshes.size(); ++k) {
             INFO("point " << x[0] << " " << x[1] << " " << x[2] << ", piece " << k);
-            CHECK(isInsideMesh(meshes[k], x) == (result.pieces[k].cells[0] == expected));
+            const std::vector<uint32_t>& has = result.pieces[k].cells;
+            CHECK(isInsideMesh(meshes[k], x) == (std::count(has.begin(), has.end(), expected) == 1));
         }
     }
 }
@@ -514,4 +519,47 @@ TEST_CASE("pieces: the same result with 1 and 2 threads, and the written files")
     for (const auto& e : std::filesystem::directory_iterator(dir.path()))
         entries += e.path().filename().string()[0] == '.';
     CHECK(entries == 0);  // no staging directory left
+}
+
+TEST_CASE("pieces: two pieces merged into one keep every voxel, and the others are numbered down") {
+    VoxelField field = buildField(*sdf::levelSetGrid(shell()));
+    const partition::PartitionResult quadrants = quadrantCells(-5.3, 10.4);
+    const GridCells cells = toGridCells(quadrants.cells, Transform4d::identity());
+    labelCells(field, cells);
+    Grouping g =
+        groupPieces(field, cells, quadrants.pieces, Transform4d::identity(), 10.0, 0.0, RunContext::silent());
+    REQUIRE(g.pieces.size() == 4);
+    auto owned = [&](uint32_t p) {
+        size_t n = 0;
+        for (size_t s = 0; s < field.phi.size(); ++s) n += field.isActive[s] && field.owner[s] == p ? 1 : 0;
+        return n;
+    };
+    const size_t one = owned(1), two = owned(2), three = owned(3);
+    const double volume = g.pieces[1].shellVolumeMm3 + g.pieces[3].shellVolumeMm3;
+    std::vector<uint32_t> cellsOf13 = g.pieces[1].cells;
+    cellsOf13.insert(cellsOf13.end(), g.pieces[3].cells.begin(), g.pieces[3].cells.end());
+    std::sort(cellsOf13.begin(), cellsOf13.end());
+    const std::vector<uint32_t> cellsOf2 = g.pieces[2].cells;
+    REQUIRE(isMergeable(g.cellSets, 1, 3));
+
+    CHECK(mergePieces(g.pieces, g.cellSets, field, 3, 1) == 2);  // 3 keeps, 1 goes: 3 becomes 2
+    REQUIRE(g.pieces.size() == 3);
+    for (uint32_t p = 0; p < 3; ++p) CHECK(g.pieces[p].id == p);
+    CHECK(owned(2) == one + three);
+    CHECK(owned(1) == two);  // the old piece 2, numbered down
+    CHECK(owned(3) == 0);
+    CHECK(g.pieces[2].cells == cellsOf13);
+    CHECK(g.pieces[1].cells == cellsOf2);
+    CHECK(g.pieces[2].shellVolumeMm3 == doctest::Approx(volume));
+    // The union's cells bound it no more: only the other two cells cut it.
+    CHECK(g.cellSets[2].members == cellsOf13);
+    for (uint32_t c : g.cellSets[2].cutters) CHECK(!g.cellSets[2].isMember[c]);
+    CHECK(g.cellSets[2].cutters.size() == 2);
+    // Faces recomputed: the union touches both others, and they each other.
+    g.faces = faceContacts(field, cells, g.cellSets, g.pieces);
+    CHECK(g.pieces[2].neighbors.size() == 2);
+    // A re-cut piece is a cell region cut by a plane: it is not merged.
+    g.cellSets[0].halfSpaces.push_back({{1, 0, 0}, 0.0});
+    CHECK_FALSE(isMergeable(g.cellSets, 0, 2));
+    CHECK_FALSE(isMergeable(g.cellSets, 1, 1));
 }

@@ -1,12 +1,17 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "cli.h"
 
+#include <sys/resource.h>
+#include <sys/sysinfo.h>
 #include <tbb/global_control.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
+#include <exception>
 #include <iostream>
 #include <memory>
 #include <new>
@@ -56,6 +61,61 @@ const char* levelPrefix(LogLevel level) {
             return "warning: ";
     }
     return "";
+}
+
+/// A ceiling on the address space (RLIMIT_AS) at 90 % of the machine's memory and swap: an
+/// allocation beyond it fails with std::bad_alloc, which run() reports as "out of memory" (exit 3),
+/// where the kernel's OOM killer would end the run, or another process, without a word (seen once
+/// at 700 mm and not reproduced, docs/benchmarks.md). The stages' own guards (--max-memory-gb)
+/// refuse earlier with an estimate; this catches what they do not estimate. A lower limit the user
+/// set stays. Not under AddressSanitizer or ThreadSanitizer, whose shadow memory reserves terabytes
+/// of address space.
+void limitAddressSpace() {
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define ZOMEFAB_SANITIZED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || defined(ZOMEFAB_SANITIZED)
+    return;
+#else
+    struct sysinfo info {};
+    if (sysinfo(&info) != 0) return;
+    const double total = (double(info.totalram) + double(info.totalswap)) * double(info.mem_unit);
+    const rlim_t ceiling = rlim_t(0.9 * total);
+    struct rlimit limit {};
+    if (getrlimit(RLIMIT_AS, &limit) != 0) return;
+    if (limit.rlim_cur != RLIM_INFINITY && limit.rlim_cur <= ceiling) return;
+    limit.rlim_cur = ceiling;
+    if (limit.rlim_max != RLIM_INFINITY && limit.rlim_max < ceiling) limit.rlim_cur = limit.rlim_max;
+    setrlimit(RLIMIT_AS, &limit);
+#endif
+}
+
+constexpr const char* kOutOfMemory =
+    "out of memory (the limit is 90 % of the machine's memory and swap, or a lower ulimit -v): a coarser "
+    "--voxel-mm or a smaller --height-mm needs less";
+
+/// The tool's name for onTerminate, kept where no allocation is needed to read it.
+char gToolName[64] = "zomefab";
+
+/// std::terminate in a tool: one line and exit 3, not an abort. When memory runs out inside
+/// OpenVDB, its tree destructors allocate while the std::bad_alloc unwinds, which ends here (seen
+/// with the address-space ceiling below). Only write(2) and _exit: the heap may be exhausted. A
+/// staging directory left behind is removed by the next run into the same place (docs/cli.md).
+[[noreturn]] void onTerminate() {
+    const char* what = "internal error (std::terminate)";
+    if (const std::exception_ptr e = std::current_exception()) {
+        try {
+            std::rethrow_exception(e);
+        } catch (const std::bad_alloc&) {
+            what = kOutOfMemory;
+        } catch (...) {
+        }
+    }
+    for (const char* part : {static_cast<const char*>(gToolName), ": error: ", what, "\n"})
+        if (::write(2, part, std::strlen(part)) < 0) break;
+    ::_exit(3);
 }
 
 }  // namespace
@@ -123,6 +183,9 @@ int Tool::run(int argc, char** argv, const std::function<int(nlohmann::json&)>& 
     };
     mContext = std::make_unique<RunContext>(log, progress, &gInterrupted);
     for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, onInterrupt);
+    std::snprintf(gToolName, sizeof gToolName, "%s", mName.c_str());
+    std::set_terminate(onTerminate);
+    limitAddressSpace();
 
     std::unique_ptr<tbb::global_control> threadLimit;
     if (mCommon.threads > 0)
@@ -146,7 +209,7 @@ int Tool::run(int argc, char** argv, const std::function<int(nlohmann::json&)>& 
         std::cerr << mName << ": error: " << e.what() << '\n';
         return exitCodeFor(e.code());
     } catch (const std::bad_alloc&) {
-        std::cerr << mName << ": error: out of memory\n";
+        std::cerr << mName << ": error: " << kOutOfMemory << '\n';
         return 3;
     } catch (const std::exception& e) {
         std::cerr << mName << ": error: internal: " << e.what() << '\n';

@@ -218,8 +218,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
     context.progress("pieces", 0.25);
     context.throwIfCancelled();
 
-    planPieces(out, field, cells, grouping, *shell, frame, frameToGridMm, fabrication.wallMm, out.options,
-               context);
+    planPieces(out, field, cells, grouping, *shell, frame, frameToGridMm, fabrication, out.options, context);
     // An object that cannot be built is said before the meshing, the stage's longest step.
     if (out.options.tenons.maxPerPiece > 0) requireBuildable(out);
     context.progress("pieces", 0.35);

@@ -137,6 +137,7 @@ struct Pieces {
     /// Pieces cut in two because the frame was in the way of every direction (docs/mounting.md):
     /// each adds one piece to what the partition asked for.
     size_t recutPieces = 0;
+    size_t mergedPieces = 0;  ///< under-held pieces printed as one with a neighbour (docs/mounting.md)
     Transform4d frameToGridMm;
     Transform4d gridTransformMm;  ///< the shell's LevelSetInfo::transformMm (input mesh → grid mm)
     PiecesOptions options;

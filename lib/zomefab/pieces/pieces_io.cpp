@@ -188,6 +188,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                     {"slivers_merged", all.sliversMerged},
                     {"isolated_slivers", all.isolatedSlivers},
                     {"recut_pieces", all.recutPieces},
+                    {"merged_pieces", all.mergedPieces},
                     {"tenons", tenonCount},
                     {"pieces_with_few_tenons", fewTenons},
                     {"labelled", labelled}};

@@ -269,6 +269,7 @@ Pieces piecesFromJson(const json& j, const std::string& directory) {
     out.sliversMerged = countFromJson(summary, "slivers_merged", 0);
     out.isolatedSlivers = countFromJson(summary, "isolated_slivers", 0);
     out.recutPieces = countFromJson(summary, "recut_pieces", 0);
+    out.mergedPieces = countFromJson(summary, "merged_pieces", 0);
     return out;
 }
 

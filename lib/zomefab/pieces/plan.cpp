@@ -9,6 +9,7 @@
 
 #include "zomefab/core/format.h"
 #include "zomefab/core/run_context.h"
+#include "zomefab/pieces/detail/merges.h"
 #include "zomefab/pieces/detail/mounting.h"
 #include "zomefab/pieces/detail/pins.h"
 #include "zomefab/pieces/detail/splits.h"
@@ -43,6 +44,11 @@ void warnShortfall(const Pieces& out, const TenonOptions& o, const RunContext& c
 }
 
 constexpr int kRecutRounds = 5;  ///< plan, re-cut the blocked pieces, plan again: at most this often
+/// Merge under-held pieces, plan again: at most this often (each piece merges once per round; the
+/// elephant at 400 mm merges three specks into one piece in three rounds, 0.7 s each).
+constexpr int kMergeRounds = 8;
+/// When a round's merges together do not help, this many are tried one by one (each a plan).
+constexpr size_t kSingleMergeTrials = 4;
 
 /// The box every piece's voxels and every ball lie in (grid mm): the frame sweeps' rectangle.
 Box3d planBounds(const VoxelField& field, const zome::Structure& frame, const Transform4d& frameToGridMm) {
@@ -152,12 +158,117 @@ mount::InstallationPlan planOverCandidates(const Pieces& out, const VoxelField& 
     }
 }
 
+/// The tenon candidates of the pieces as they are now, those other pieces' tenons took (@p lost)
+/// rejected.
+std::vector<TenonCandidate> freshCandidates(const zome::Structure& frame, const Transform4d& frameToGridMm,
+                                            const ShellProbe& probe, const PiecesOptions& opt,
+                                            const std::set<std::pair<zome::BallId, int>>& lost) {
+    std::vector<TenonCandidate> candidates = findTenonCandidates(frame, frameToGridMm, probe, opt.tenons);
+    for (TenonCandidate& c : candidates)
+        if (c.rejection.empty() && lost.count({c.tenon.ball, c.tenon.hole}))
+            c.rejection = "another tenon in the way";
+    return candidates;
+}
+
+/// The pegs each piece gets along its planned direction.
+std::vector<size_t> pegCounts(const std::vector<TenonCandidate>& candidates,
+                              const mount::InstallationPlan& plan, const TenonOptions& o) {
+    const TenonPlan tenons = chooseTenons(candidates, plan.holeOfPiece, o);
+    std::vector<size_t> pegs;
+    for (const auto& list : tenons.perPiece) pegs.push_back(list.size());
+    return pegs;
+}
+
+size_t underHeld(const std::vector<size_t>& pegs, int minPerPiece) {
+    return size_t(std::count_if(pegs.begin(), pegs.end(), [&](size_t n) { return n < size_t(minPerPiece); }));
+}
+
+/// What a merge round changes, kept to undo it.
+struct PlanState {
+    std::vector<Piece> pieces;
+    std::vector<CellSet> cellSets;
+    FaceContacts faces;
+    std::vector<uint32_t> owner;
+    mount::InstallationPlan plan;
+    std::vector<TenonCandidate> candidates;
+};
+
+/// Pieces fewer than minPerPiece pegs hold are printed as one with a neighbour (detail/merges.h) and
+/// the plan made again, while that leaves fewer such pieces and a plan that can be carried out. Each
+/// round tries every piece's best merge at once, and when that does not help, the merges one by one
+/// (at most kSingleMergeTrials); a trial that does not help is undone.
+void mergeUnderHeld(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
+                    const ShellProbe& probe, const zome::Structure& frame, const Transform4d& frameToGridMm,
+                    const FrameSweeps& sweeps, std::vector<TenonCandidate>& candidates,
+                    std::set<std::pair<zome::BallId, int>>& lost, const Fabrication& fabrication,
+                    const PiecesOptions& opt, const RunContext& context) {
+    MergeSearch search;
+    search.printerMm = fabrication.printerMm;
+    search.fitMarginMm = fabrication.fitMarginMm;
+    search.minPerPiece = opt.tenons.minPerPiece;
+    search.maxPerPiece = opt.tenons.maxPerPiece;
+    const int minPegs = opt.tenons.minPerPiece;
+    // Merges @p pairs and plans again; keeps the result when fewer than @p before pieces are
+    // under-held and the plan can be carried out, else undoes it. Returns the new count or 0.
+    auto attempt = [&](const std::vector<std::pair<uint32_t, uint32_t>>& pairs, size_t before) -> size_t {
+        const Stopwatch clock;
+        PlanState kept{out.pieces, grouping.cellSets, grouping.faces, field.owner, out.plan, candidates};
+        const std::set<std::pair<zome::BallId, int>> keptLost = lost;
+        mergeAll(out.pieces, grouping.cellSets, field, pairs);
+        grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
+        candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
+        out.plan = planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context);
+        const size_t after = out.plan.isBuildable()
+                                 ? underHeld(pegCounts(candidates, out.plan, opt.tenons), minPegs)
+                                 : SIZE_MAX;
+        context.debug("mounting: " + std::to_string(pairs.size()) + " merge(s): pieces under " +
+                      std::to_string(minPegs) + " pegs " + std::to_string(before) + " -> " +
+                      (after == SIZE_MAX ? std::string("no plan") : std::to_string(after)) + " in " +
+                      formatNumber(clock.seconds(), 3) + " s");
+        if (after < before) {
+            out.mergedPieces += pairs.size();
+            context.detail(std::to_string(pairs.size()) +
+                           " piece(s) too few pegs would hold printed as one with a neighbour (" +
+                           std::to_string(before) + " -> " + std::to_string(after) + " pieces under " +
+                           std::to_string(minPegs) + " pegs)");
+            return after;
+        }
+        out.pieces = std::move(kept.pieces);
+        grouping.cellSets = std::move(kept.cellSets);
+        grouping.faces = std::move(kept.faces);
+        field.owner = std::move(kept.owner);
+        out.plan = std::move(kept.plan);
+        candidates = std::move(kept.candidates);
+        lost = keptLost;
+        return 0;
+    };
+    for (int round = 0; round < kMergeRounds && out.plan.isBuildable(); ++round) {
+        context.throwIfCancelled();
+        const size_t before = underHeld(pegCounts(candidates, out.plan, opt.tenons), minPegs);
+        if (before == 0) return;
+        const std::vector<MergeOption> options =
+            mergeOptions(out.pieces, grouping.cellSets, field, pegCounts(candidates, out.plan, opt.tenons),
+                         plannerInput(out, field, candidates), sweeps, search);
+        const auto batch = disjointMerges(options);
+        if (batch.empty()) return;
+        if (attempt(batch, before) > 0) continue;
+        bool isMerged = false;
+        for (size_t i = 0; i < options.size() && i < kSingleMergeTrials && !isMerged; ++i) {
+            if (batch.size() == 1 && batch[0] == std::make_pair(options[i].piece, options[i].neighbor))
+                continue;
+            context.throwIfCancelled();
+            isMerged = attempt({{options[i].piece, options[i].neighbor}}, before) > 0;
+        }
+        if (!isMerged) return;
+    }
+}
+
 /// The installation plan, re-cutting blocked pieces and planning again (a few rounds), and the
 /// tenons along each piece's direction.
 void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
                            const ShellProbe& probe, const zome::Structure& frame,
-                           const Transform4d& frameToGridMm, const PiecesOptions& opt,
-                           const RunContext& context) {
+                           const Transform4d& frameToGridMm, const Fabrication& fabrication,
+                           const PiecesOptions& opt, const RunContext& context) {
     const FrameSweeps sweeps(frame, frameToGridMm, planBounds(field, frame, frameToGridMm), field.voxelMm,
                              opt.mount.frameMarginMm);
     std::vector<TenonCandidate> candidates;
@@ -165,10 +276,7 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
     size_t lastUnplaced = SIZE_MAX;
     for (int round = 0;; ++round) {
         const Stopwatch clock;
-        candidates = findTenonCandidates(frame, frameToGridMm, probe, opt.tenons);
-        for (TenonCandidate& c : candidates)
-            if (c.rejection.empty() && lost.count({c.tenon.ball, c.tenon.hole}))
-                c.rejection = "another tenon in the way";
+        candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
         context.debug("mounting: " + std::to_string(candidates.size()) + " tenon candidates in " +
                       formatNumber(clock.seconds(), 3) + " s");
         context.throwIfCancelled();
@@ -193,6 +301,8 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
                       " s");
         if (cut == 0) break;
     }
+    mergeUnderHeld(out, field, cells, grouping, probe, frame, frameToGridMm, sweeps, candidates, lost,
+                   fabrication, opt, context);
     const size_t unpinned = placePins(out, field, cells, grouping.cellSets, opt, GlueOnRule{}.minCosine);
     if (unpinned > 0)
         context.warn(std::to_string(unpinned) + " of " +
@@ -213,13 +323,13 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
 
 void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
                 const FloatGrid& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
-                double wallMm, const PiecesOptions& opt, const RunContext& context) {
+                const Fabrication& fabrication, const PiecesOptions& opt, const RunContext& context) {
     const FloatGrid::ConstAccessor probeAccessor = shell.getConstAccessor();
     const openvdb::tools::GridSampler<FloatGrid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
         probeAccessor, shell.transform());
     ShellProbe probe;
     probe.voxelMm = field.voxelMm;
-    probe.wallMm = wallMm;
+    probe.wallMm = fabrication.wallMm;
     probe.signedDistanceMm = [&](const Vec3d& p) {
         return double(sampler.wsSample(openvdb::Vec3d(p[0], p[1], p[2])));
     };
@@ -231,7 +341,8 @@ void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping
         return int64_t(field.owner[s]);
     };
     if (opt.tenons.maxPerPiece > 0) {
-        planMountingAndTenons(out, field, cells, grouping, probe, frame, frameToGridMm, opt, context);
+        planMountingAndTenons(out, field, cells, grouping, probe, frame, frameToGridMm, fabrication, opt,
+                              context);
     } else {
         out.plan.holeOfPiece.assign(out.pieces.size(), -1);
         out.plan.problems.push_back("no tenons (--max-tenons 0): nothing holds the pieces on the frame");

@@ -244,12 +244,14 @@ std::optional<SplitPlane> findFitSplit(const std::vector<Vec3d>& voxels, const p
     return best;
 }
 
-namespace {
-
-/// The cells of side @p factor voxels (from @p field's grid origin) holding an inside voxel of
-/// @p slots, as their centres (grid mm), in slot order.
-std::vector<Vec3d> coarseCells(const VoxelField& field, const std::vector<size_t>& slots, int factor) {
-    std::vector<Vec3d> out;
+CoarseCells coarseInside(const VoxelField& field, const std::vector<size_t>& slots) {
+    constexpr double kMaxCells = 500000.0;
+    size_t inside = 0;
+    for (size_t s : slots) inside += field.isInside(s) ? 1 : 0;
+    const int factor = std::max({1, int(std::ceil(2.0 / field.voxelMm - 1e-9)),
+                                 int(std::ceil(std::cbrt(double(inside) / kMaxCells)))});
+    CoarseCells out;
+    out.cellMm = factor * field.voxelMm;
     std::unordered_map<int64_t, char> seen;
     for (size_t s : slots) {
         if (!field.isInside(s)) continue;
@@ -260,18 +262,21 @@ std::vector<Vec3d> coarseCells(const VoxelField& field, const std::vector<size_t
         if (!seen.emplace(packCell(i, j, k), 1).second) continue;
         const double half = 0.5 * double(factor - 1);
         const Vec3d corner = field.world(Coord(int(i * factor), int(j * factor), int(k * factor)));
-        out.push_back(add(corner, scale(Vec3d{1, 1, 1}, half * field.voxelMm)));
+        out.centresMm.push_back(add(corner, scale(Vec3d{1, 1, 1}, half * field.voxelMm)));
     }
     return out;
 }
 
-}  // namespace
+partition::PrinterFit coarseFit(const CoarseCells& cells, const Vec3d& printerMm, double marginMm) {
+    // A cell's centre lies up to half its diagonal inside the piece's true extent.
+    return partition::fitInPrinter(cells.centresMm, printerMm,
+                                   marginMm + 0.5 * std::sqrt(3.0) * cells.cellMm);
+}
 
 size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
                      const GridCells& cells, const std::vector<partition::Piece>& requests,
                      bool isRequestFitTrusted, const Vec3d& printerMm, double marginMm, double minVolumeMm3,
                      const RunContext& context) {
-    constexpr double kMaxCells = 500000.0;
     // Each piece's band and inside slots, gathered once (a scan of the whole field per cut is slow
     // at 700 mm).
     std::vector<std::vector<size_t>> slotsOf(pieces.size());
@@ -293,20 +298,16 @@ size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField&
         context.throwIfCancelled();
         const uint32_t p = queue[q];
         if (isFitted(p)) continue;
-        size_t inside = 0;
-        for (size_t s : slotsOf[p]) inside += field.isInside(s) ? 1 : 0;
-        const int factor = std::max({1, int(std::ceil(2.0 / field.voxelMm - 1e-9)),
-                                     int(std::ceil(std::cbrt(double(inside) / kMaxCells)))});
+        const CoarseCells points = coarseInside(field, slotsOf[p]);
+        const partition::PrinterFit whole = coarseFit(points, printerMm, marginMm);
+        if (whole.fits) continue;
         SplitSearch search;
-        search.voxelMm = factor * field.voxelMm;
+        search.voxelMm = points.cellMm;
         search.originMm = field.world(Coord(0, 0, 0));
         search.minVolumeMm3 = minVolumeMm3;
-        // A cell's centre lies up to half its diagonal inside the piece's true extent.
-        const double margin = marginMm + 0.5 * std::sqrt(3.0) * search.voxelMm;
-        const std::vector<Vec3d> points = coarseCells(field, slotsOf[p], factor);
-        const partition::PrinterFit whole = partition::fitInPrinter(points, printerMm, margin);
-        if (whole.fits) continue;
-        const std::optional<SplitPlane> plane = findFitSplit(points, whole, printerMm, margin, search);
+        const double margin = marginMm + 0.5 * std::sqrt(3.0) * search.voxelMm;  // as coarseFit's
+        const std::optional<SplitPlane> plane =
+            findFitSplit(points.centresMm, whole, printerMm, margin, search);
         if (!plane) continue;
         std::vector<size_t> otherSlots;
         const uint32_t other =

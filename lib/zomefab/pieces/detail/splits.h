@@ -67,6 +67,17 @@ size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField&
                      bool isRequestFitTrusted, const Vec3d& printerMm, double marginMm, double minVolumeMm3,
                      const RunContext& context);
 
+/// A piece's inside voxels (of @p slots) as the centres of cells of about 2 mm or coarser (at most
+/// ~500,000 cells): what the printer-fit tests and the fit cuts run on.
+struct CoarseCells {
+    std::vector<Vec3d> centresMm;  ///< grid mm, in slot order
+    double cellMm = 0.0;           ///< the cells' side
+};
+CoarseCells coarseInside(const VoxelField& field, const std::vector<size_t>& slots);
+/// The printer fit of @p cells (fitInPrinter), each box side grown by @p marginMm and by the half
+/// diagonal of a cell.
+partition::PrinterFit coarseFit(const CoarseCells& cells, const Vec3d& printerMm, double marginMm);
+
 /// Cuts piece @p p along @p plane: its voxels beyond the plane (inside and band) go to a new piece
 /// with the next id, its cell set with the other half-space; shell volumes recounted. Returns the
 /// new piece's id. The caller recomputes the face contacts (faceContacts). With @p slots (the

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "zomefab/core/fabrication.h"
 #include "zomefab/core/run_context.h"
 #include "zomefab/pieces/detail/grouping.h"
 #include "zomefab/pieces/detail/voxels.h"
@@ -19,11 +20,13 @@ namespace zomefab::pieces::detail {
 
 /// The installation plan (every piece's direction and the order, docs/mounting.md; pieces the
 /// frame is in the way of re-cut, which changes @p field's owners and @p grouping's cell sets and
-/// faces), then the tenons (paper §6.1) along each piece's direction and the engraved numbers,
-/// against the shell @p shell. Warnings for pieces short of tenons or numbers.
+/// faces; pieces too few pegs hold merged with a neighbour, which renumbers them), then the tenons
+/// (paper §6.1) along each piece's direction and the engraved numbers, against the shell @p shell.
+/// @p fabrication: the wall (a stem's end stays in it) and the printer (what a merged piece must
+/// fit). Warnings for pieces short of tenons or numbers.
 void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
                 const FloatGrid& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
-                double wallMm, const PiecesOptions& options, const RunContext& context);
+                const Fabrication& fabrication, const PiecesOptions& options, const RunContext& context);
 
 /// For every piece, the leaves that hold its inside voxels and their 26 neighbours (the band is
 /// three voxels wide).
