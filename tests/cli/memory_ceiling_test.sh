@@ -18,6 +18,9 @@ limit=$(awk '/^Max address space/ {print $4}' /proc/$pid/limits)
 kill -INT $pid; wait $pid
 total=$(awk '/^MemTotal:|^SwapTotal:/ {sum += $2} END {print sum * 1024}' /proc/meminfo)
 expected=$(awk -v t="$total" 'BEGIN {printf "%.0f", 0.9 * t}')
+# A lower limit set before (a container's, a user's ulimit -v) stays.
+inherited=$(ulimit -v)
+[ "$inherited" != unlimited ] && [ $((inherited * 1024)) -lt "$expected" ] && expected=$((inherited * 1024))
 echo "address space limit $limit bytes, 90 % of memory and swap $expected bytes"
 # unistd's mem_unit and /proc/meminfo's kB round differently: within 0.1 %.
 awk -v l="$limit" -v e="$expected" 'BEGIN {exit !(l != "unlimited" && l / e > 0.999 && l / e < 1.001)}' ||
