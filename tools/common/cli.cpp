@@ -85,9 +85,10 @@ void limitAddressSpace() {
     const rlim_t ceiling = rlim_t(0.9 * total);
     struct rlimit limit {};
     if (getrlimit(RLIMIT_AS, &limit) != 0) return;
+    // A soft limit at or under the ceiling stays; the hard limit, never under the soft, is then
+    // above the ceiling too.
     if (limit.rlim_cur != RLIM_INFINITY && limit.rlim_cur <= ceiling) return;
     limit.rlim_cur = ceiling;
-    if (limit.rlim_max != RLIM_INFINITY && limit.rlim_max < ceiling) limit.rlim_cur = limit.rlim_max;
     setrlimit(RLIMIT_AS, &limit);
 #endif
 }
@@ -101,7 +102,7 @@ char gToolName[64] = "zomefab";
 
 /// std::terminate in a tool: one line and exit 3, not an abort. When memory runs out inside
 /// OpenVDB, its tree destructors allocate while the std::bad_alloc unwinds, which ends here (seen
-/// with the address-space ceiling below). Only write(2) and _exit: the heap may be exhausted. A
+/// with the address-space ceiling above). Only write(2) and _exit: the heap may be exhausted. A
 /// staging directory left behind is removed by the next run into the same place (docs/cli.md).
 [[noreturn]] void onTerminate() {
     const char* what = "internal error (std::terminate)";

@@ -191,6 +191,7 @@ struct PlanState {
     std::vector<uint32_t> owner;
     mount::InstallationPlan plan;
     std::vector<TenonCandidate> candidates;
+    std::set<std::pair<zome::BallId, int>> lost;
 };
 
 /// Pieces fewer than minPerPiece pegs hold are printed as one with a neighbour (detail/merges.h) and
@@ -212,8 +213,8 @@ void mergeUnderHeld(Pieces& out, VoxelField& field, const GridCells& cells, Grou
     // under-held and the plan can be carried out, else undoes it. Returns the new count or 0.
     auto attempt = [&](const std::vector<std::pair<uint32_t, uint32_t>>& pairs, size_t before) -> size_t {
         const Stopwatch clock;
-        PlanState kept{out.pieces, grouping.cellSets, grouping.faces, field.owner, out.plan, candidates};
-        const std::set<std::pair<zome::BallId, int>> keptLost = lost;
+        PlanState kept{out.pieces, grouping.cellSets, grouping.faces, field.owner, out.plan, candidates,
+                       lost};
         mergeAll(out.pieces, grouping.cellSets, field, pairs);
         grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
         candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
@@ -239,16 +240,16 @@ void mergeUnderHeld(Pieces& out, VoxelField& field, const GridCells& cells, Grou
         field.owner = std::move(kept.owner);
         out.plan = std::move(kept.plan);
         candidates = std::move(kept.candidates);
-        lost = keptLost;
+        lost = std::move(kept.lost);
         return 0;
     };
     for (int round = 0; round < kMergeRounds && out.plan.isBuildable(); ++round) {
         context.throwIfCancelled();
-        const size_t before = underHeld(pegCounts(candidates, out.plan, opt.tenons), minPegs);
+        const std::vector<size_t> pegs = pegCounts(candidates, out.plan, opt.tenons);
+        const size_t before = underHeld(pegs, minPegs);
         if (before == 0) return;
-        const std::vector<MergeOption> options =
-            mergeOptions(out.pieces, grouping.cellSets, field, pegCounts(candidates, out.plan, opt.tenons),
-                         plannerInput(out, field, candidates), sweeps, search);
+        const std::vector<MergeOption> options = mergeOptions(
+            out.pieces, grouping.cellSets, field, pegs, plannerInput(out, field, candidates), sweeps, search);
         const auto batch = disjointMerges(options);
         if (batch.empty()) return;
         if (attempt(batch, before) > 0) continue;

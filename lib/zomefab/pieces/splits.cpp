@@ -267,10 +267,13 @@ CoarseCells coarseInside(const VoxelField& field, const std::vector<size_t>& slo
     return out;
 }
 
-partition::PrinterFit coarseFit(const CoarseCells& cells, const Vec3d& printerMm, double marginMm) {
+double coarseMarginMm(const CoarseCells& cells, double marginMm) {
     // A cell's centre lies up to half its diagonal inside the piece's true extent.
-    return partition::fitInPrinter(cells.centresMm, printerMm,
-                                   marginMm + 0.5 * std::sqrt(3.0) * cells.cellMm);
+    return marginMm + 0.5 * std::sqrt(3.0) * cells.cellMm;
+}
+
+partition::PrinterFit coarseFit(const CoarseCells& cells, const Vec3d& printerMm, double marginMm) {
+    return partition::fitInPrinter(cells.centresMm, printerMm, coarseMarginMm(cells, marginMm));
 }
 
 size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
@@ -305,9 +308,8 @@ size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField&
         search.voxelMm = points.cellMm;
         search.originMm = field.world(Coord(0, 0, 0));
         search.minVolumeMm3 = minVolumeMm3;
-        const double margin = marginMm + 0.5 * std::sqrt(3.0) * search.voxelMm;  // as coarseFit's
         const std::optional<SplitPlane> plane =
-            findFitSplit(points.centresMm, whole, printerMm, margin, search);
+            findFitSplit(points.centresMm, whole, printerMm, coarseMarginMm(points, marginMm), search);
         if (!plane) continue;
         std::vector<size_t> otherSlots;
         const uint32_t other =

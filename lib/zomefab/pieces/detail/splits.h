@@ -74,8 +74,9 @@ struct CoarseCells {
     double cellMm = 0.0;           ///< the cells' side
 };
 CoarseCells coarseInside(const VoxelField& field, const std::vector<size_t>& slots);
-/// The printer fit of @p cells (fitInPrinter), each box side grown by @p marginMm and by the half
-/// diagonal of a cell.
+/// @p marginMm grown by the half diagonal of a cell: the fit margin for the cells' centres.
+double coarseMarginMm(const CoarseCells& cells, double marginMm);
+/// The printer fit of @p cells (fitInPrinter), each box side grown by coarseMarginMm.
 partition::PrinterFit coarseFit(const CoarseCells& cells, const Vec3d& printerMm, double marginMm);
 
 /// Cuts piece @p p along @p plane: its voxels beyond the plane (inside and band) go to a new piece
