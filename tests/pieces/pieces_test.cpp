@@ -22,6 +22,7 @@
 #include "zomefab/pieces/detail/box_distance.h"
 #include "zomefab/pieces/detail/grouping.h"
 #include "zomefab/pieces/detail/merges.h"
+#include "zomefab/pieces/detail/splits.h"
 #include "zomefab/pieces/detail/voxels.h"
 #include "zomefab/pieces/orientation.h"
 #include "zomefab/pieces/pieces_io.h"
@@ -97,6 +98,22 @@ void checkClosedAndFits(const Pieces& result) {
         CHECK(baseMm2 >= 25.0);  // kMinBaseMm2
         CHECK(p.baseAreaMm2 == doctest::Approx(baseMm2).epsilon(1e-6));
     }
+}
+
+/// The shell's voxels grouped into the four pieces of quadrantCells(−5.3, 10.4).
+struct QuadrantPieces {
+    VoxelField field;
+    GridCells cells;
+    Grouping grouping;
+};
+QuadrantPieces quadrantPieces() {
+    QuadrantPieces q{buildField(*sdf::levelSetGrid(shell())), {}, {}};
+    const partition::PartitionResult quadrants = quadrantCells(-5.3, 10.4);
+    q.cells = toGridCells(quadrants.cells, Transform4d::identity());
+    labelCells(q.field, q.cells);
+    q.grouping = groupPieces(q.field, q.cells, quadrants.pieces, Transform4d::identity(), 10.0, 0.0,
+                             RunContext::silent());
+    return q;
 }
 
 }  // namespace
@@ -522,12 +539,10 @@ TEST_CASE("pieces: the same result with 1 and 2 threads, and the written files")
 }
 
 TEST_CASE("pieces: two pieces merged into one keep every voxel, and the others are numbered down") {
-    VoxelField field = buildField(*sdf::levelSetGrid(shell()));
-    const partition::PartitionResult quadrants = quadrantCells(-5.3, 10.4);
-    const GridCells cells = toGridCells(quadrants.cells, Transform4d::identity());
-    labelCells(field, cells);
-    Grouping g =
-        groupPieces(field, cells, quadrants.pieces, Transform4d::identity(), 10.0, 0.0, RunContext::silent());
+    QuadrantPieces q = quadrantPieces();
+    VoxelField& field = q.field;
+    const GridCells& cells = q.cells;
+    Grouping& g = q.grouping;
     REQUIRE(g.pieces.size() == 4);
     auto owned = [&](uint32_t p) {
         size_t n = 0;
@@ -562,4 +577,65 @@ TEST_CASE("pieces: two pieces merged into one keep every voxel, and the others a
     g.cellSets[0].halfSpaces.push_back({{1, 0, 0}, 0.0});
     CHECK_FALSE(isMergeable(g.cellSets, 0, 2));
     CHECK_FALSE(isMergeable(g.cellSets, 1, 1));
+}
+
+TEST_CASE("pieces: a piece whose tenon reaches past the printer is cut; the others are left as they are") {
+    // Four quadrants of the 200 mm shell, each about 100 × 200 × 100 mm: all fit a 210 mm printer.
+    // A tenon on piece 0 reaching 205 mm below the sphere makes it 405 mm long: longer than the
+    // printer's diagonal (364 mm).
+    QuadrantPieces q = quadrantPieces();
+    REQUIRE(q.grouping.pieces.size() == 4);
+    const TenonOptions tenonOptions;
+    const Vec3d printer{210, 210, 210};
+    std::vector<size_t> before(4);
+    for (size_t s = 0; s < q.field.phi.size(); ++s)
+        if (q.field.isActive[s] && q.field.owner[s] < 4) ++before[q.field.owner[s]];
+    std::vector<std::string> messages;
+    RunContext context([&](LogLevel, const std::string& m) { messages.push_back(m); }, nullptr);
+    CHECK(splitOverPrinter(q.grouping.pieces, q.grouping, q.field, q.cells, tenonOptions, printer, 2.0, 0.0,
+                           context) == 0);
+    CHECK(messages.empty());
+
+    Tenon far;
+    far.hole = 0;
+    far.axisGrid = {0, 1, 0};
+    far.longSideGrid = {1, 0, 0};
+    far.ballCenterGridMm = {0, -300, 0};
+    far.shoulderMm = 0, far.pegTipMm = -5, far.endMm = 100;
+    for (const Vec3d& x : tenonHullMm(far, tenonOptions)) CHECK(x[1] >= -305.0 - 1e-9);
+    q.grouping.pieces[0].tenons = {far};
+    CHECK(splitOverPrinter(q.grouping.pieces, q.grouping, q.field, q.cells, tenonOptions, printer, 2.0, 0.0,
+                           context) == 1);
+    REQUIRE(q.grouping.pieces.size() == 5);
+    std::vector<size_t> after(5);
+    for (size_t s = 0; s < q.field.phi.size(); ++s)
+        if (q.field.isActive[s] && q.field.owner[s] < 5) ++after[q.field.owner[s]];
+    CHECK(after[0] + after[4] == before[0]);
+    for (size_t p = 1; p < 4; ++p) CHECK(after[p] == before[p]);
+    REQUIRE(messages.size() == 1);
+    CHECK(messages[0].find("with its tenons") != std::string::npos);
+    CHECK(messages[0].find("cut in two (0 and 4)") != std::string::npos);
+}
+
+TEST_CASE("pieces: the fit of a solid is searched on its hull's extremes") {
+    // A 196 × 150 × 20 mm slab of 200,000 random points, turned about two axes: it fits a 200 mm
+    // cube only nearly along its own axes.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-0.5, 0.5);
+    const double c1 = std::cos(0.5), s1 = std::sin(0.5), c2 = std::cos(0.9), s2 = std::sin(0.9);
+    std::vector<Vec3d> points;
+    for (int i = 0; i < 200000; ++i) {
+        const Vec3d p{196 * u(rng), 150 * u(rng), 20 * u(rng)};
+        const Vec3d q{c1 * p[0] - s1 * p[1], s1 * p[0] + c1 * p[1], p[2]};
+        points.push_back({q[0], c2 * q[1] - s2 * q[2], s2 * q[1] + c2 * q[2]});
+    }
+    const std::vector<Vec3d> extremes = extremePoints(points);
+    CHECK(extremes.size() <= 1000);
+    CHECK(extremes.size() >= 8);
+    const partition::PrinterFit fit = fitOfSolid(points, {200, 200, 200}, 1.0);
+    CHECK(fit.fits);
+    CHECK(fit.extentsMm[2] <= 196.0 + 2.0 + 1.0);  // the longest side, margin included
+    // The box is measured on every point, not on the extremes alone.
+    const partition::PrinterFit same = partition::evaluateFit(points, fit.axes, {200, 200, 200}, 1.0);
+    CHECK(same.extentsMm[2] == doctest::Approx(fit.extentsMm[2]));
 }

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "zomefab/core/vec.h"
+#include "zomefab/partition/printer_fit.h"
 #include "zomefab/pieces/detail/box_distance.h"
 #include "zomefab/pieces/detail/support.h"
 
@@ -335,13 +336,21 @@ public:
         return bestContact >= 0;
     }
 
-    /// 4. Nothing fits: the direction with the most room (the caller fails with it).
+    /// 4. No direction tried so far fits: the direction with the most room, of the best box's
+    /// six sides (fitInPrinter: a search over every rotation, which the sphere's 256 directions
+    /// may miss by a few mm) and the sphere. The caller fails when even that does not fit.
     Vec3d mostRoom() const {
-        Vec3d down = directions[searchStart];
+        std::vector<Vec3d> tried;
+        for (const Vec3d& axis : partition::fitInPrinter(mesh.points, printer).axes) {
+            tried.push_back(axis);
+            tried.push_back(scale(axis, -1.0));
+        }
+        tried.insert(tried.end(), directions.begin() + std::ptrdiff_t(searchStart), directions.end());
+        Vec3d down = tried[0];
         double ratio = 1e300;
-        for (size_t i = searchStart; i < directions.size(); ++i) {
-            const double r = evaluate(mesh.points, directions[i], printer).placement.ratio;
-            if (r < ratio - 1e-12) ratio = r, down = directions[i];
+        for (const Vec3d& d : tried) {
+            const double r = evaluate(mesh.points, d, printer).placement.ratio;
+            if (r < ratio - 1e-12) ratio = r, down = d;
         }
         return down;
     }

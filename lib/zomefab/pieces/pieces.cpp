@@ -151,6 +151,29 @@ void meshPieces(Pieces& out, std::vector<PieceGrid>& grids, const GridCells& cel
                        " pieces have no cut face they can lie on; they rest on their largest base that fits");
 }
 
+/// How often the pieces are planned again after cuts for tenons that made a piece too large.
+constexpr int kFitRounds = 3;
+
+/// Steps 2–3 (planPieces), then the pieces the tenons made larger than the printer cut
+/// (splitOverPrinter) and everything planned again, a few rounds: a piece too large is found
+/// here, before the meshing, and not by finishPiece after it.
+void planTenonsToFit(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
+                     const FloatGrid& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
+                     const Fabrication& fabrication, const RunContext& context) {
+    for (int round = 0;; ++round) {
+        planPieces(out, field, cells, grouping, shell, frame, frameToGridMm, fabrication, out.options,
+                   context);
+        if (round == kFitRounds) return;
+        const size_t cuts =
+            splitOverPrinter(out.pieces, grouping, field, cells, out.options.tenons, fabrication.printerMm,
+                             fabrication.fitMarginMm, out.options.minPieceVolumeMm3, context);
+        if (cuts == 0) return;
+        context.info(std::to_string(cuts) +
+                     " piece(s) with their tenons larger than the printer cut by planes; planning again");
+        for (Piece& piece : out.pieces) piece.pins.clear();  // the rest is planned afresh
+    }
+}
+
 }  // namespace
 
 void checkPiecesOptions(const PiecesOptions& o) {
@@ -218,7 +241,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
     context.progress("pieces", 0.25);
     context.throwIfCancelled();
 
-    planPieces(out, field, cells, grouping, *shell, frame, frameToGridMm, fabrication, out.options, context);
+    planTenonsToFit(out, field, cells, grouping, *shell, frame, frameToGridMm, fabrication, context);
     // An object that cannot be built is said before the meshing, the stage's longest step.
     if (out.options.tenons.maxPerPiece > 0) requireBuildable(out);
     context.progress("pieces", 0.35);

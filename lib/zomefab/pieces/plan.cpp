@@ -345,6 +345,7 @@ void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping
         planMountingAndTenons(out, field, cells, grouping, probe, frame, frameToGridMm, fabrication, opt,
                               context);
     } else {
+        out.plan = {};
         out.plan.holeOfPiece.assign(out.pieces.size(), -1);
         out.plan.problems.push_back("no tenons (--max-tenons 0): nothing holds the pieces on the frame");
     }

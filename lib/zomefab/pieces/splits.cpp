@@ -10,8 +10,10 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "zomefab/core/format.h"
 #include "zomefab/mount/plan.h"
 #include "zomefab/partition/printer_fit.h"
+#include "zomefab/pieces/detail/support.h"
 
 namespace zomefab::pieces::detail {
 
@@ -273,7 +275,115 @@ double coarseMarginMm(const CoarseCells& cells, double marginMm) {
 }
 
 partition::PrinterFit coarseFit(const CoarseCells& cells, const Vec3d& printerMm, double marginMm) {
-    return partition::fitInPrinter(cells.centresMm, printerMm, coarseMarginMm(cells, marginMm));
+    return fitOfSolid(cells.centresMm, printerMm, coarseMarginMm(cells, marginMm));
+}
+
+std::vector<std::vector<size_t>> slotsOfPieces(const VoxelField& field, size_t pieceCount) {
+    std::vector<std::vector<size_t>> slotsOf(pieceCount);
+    for (size_t s = 0; s < field.phi.size(); ++s)
+        if (field.isActive[s] && field.owner[s] != kNone && field.owner[s] < pieceCount)
+            slotsOf[field.owner[s]].push_back(s);
+    return slotsOf;
+}
+
+std::vector<Vec3d> extremePoints(const std::vector<Vec3d>& points) {
+    // 1,000 directions on a Fibonacci sphere, about 6.5° apart: a point of the hull between two
+    // of their extremes lies within r (1 − cos 3.3°), 0.17 mm at r = 100 mm, of their box sides.
+    constexpr int kDirections = 1000;
+    std::vector<uint32_t> chosen;
+    for (int i = 0; i < kDirections; ++i) {
+        const double z = 1.0 - (2.0 * i + 1.0) / kDirections;
+        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+        const double phi = i * kPi * (3.0 - std::sqrt(5.0));
+        const Vec3d d{r * std::cos(phi), r * std::sin(phi), z};
+        uint32_t best = 0;
+        for (uint32_t k = 1; k < points.size(); ++k)
+            if (dot(d, points[k]) > dot(d, points[best])) best = k;
+        chosen.push_back(best);
+    }
+    std::sort(chosen.begin(), chosen.end());
+    chosen.erase(std::unique(chosen.begin(), chosen.end()), chosen.end());
+    std::vector<Vec3d> out;
+    for (uint32_t k : chosen) out.push_back(points[k]);
+    return out;
+}
+
+partition::PrinterFit fitOfSolid(const std::vector<Vec3d>& points, const Vec3d& printerMm, double marginMm) {
+    if (points.empty()) return partition::fitInPrinter(points, printerMm, marginMm);
+    // The search on the hull's extremes (fitInPrinter searches on at most 4,096 points, which
+    // a strided sample of a wall's voxels leaves a few mm short at the hull), the box on all points.
+    const partition::PrinterFit onHull = partition::fitInPrinter(extremePoints(points), printerMm, marginMm);
+    return partition::evaluateFit(points, onHull.axes, printerMm, marginMm);
+}
+
+std::vector<std::vector<Vec3d>> wallSurfaceMm(const VoxelField& field, size_t pieceCount) {
+    std::vector<std::vector<Vec3d>> out(pieceCount);
+    auto keep = [&](size_t s, const Vec3d& x) {
+        if (field.owner[s] < pieceCount) out[field.owner[s]].push_back(x);
+    };
+    // Inside voxel s, its 6-neighbour t: where the wall's surface crosses the edge between them
+    // (φ linear along it, as the mesher's edge points), or t's centre when t is another piece's
+    // (their cut plane lies between the two centres).
+    auto visit = [&](size_t s, size_t t) {
+        if (!field.isInside(s)) return;
+        const Vec3d xs = field.world(field.coordOf(s)), xt = field.world(field.coordOf(t));
+        if (!field.isInside(t)) {
+            const double a = double(field.phi[s]), b = std::max(0.0, double(field.phi[t]));
+            keep(s, madd(xs, a / (a - b), sub(xt, xs)));
+        } else if (field.owner[t] != field.owner[s]) {
+            keep(s, xt);
+        }
+    };
+    forEachForwardPair(field, [&](size_t s, size_t t) {
+        visit(s, t);
+        visit(t, s);
+    });
+    return out;
+}
+
+size_t splitOverPrinter(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
+                        const GridCells& cells, const TenonOptions& tenons, const Vec3d& printerMm,
+                        double marginMm, double minVolumeMm3, const RunContext& context) {
+    std::vector<std::vector<Vec3d>> points = wallSurfaceMm(field, pieces.size());
+    std::vector<std::vector<size_t>> slotsOf;  // gathered at the first cut
+    size_t cuts = 0;
+    const size_t pieceCount = pieces.size();
+    for (uint32_t p = 0; p < pieceCount; ++p) {
+        context.throwIfCancelled();
+        for (const Tenon& t : pieces[p].tenons)
+            for (const Vec3d& x : tenonHullMm(t, tenons)) points[p].push_back(x);
+        // The mesher's vertices lie among the wall's edge points (wallSurfaceMm).
+        const partition::PrinterFit fit = fitOfSolid(points[p], printerMm, 0.0);
+        if (fit.fits) continue;
+        if (slotsOf.empty()) slotsOf = slotsOfPieces(field, pieceCount);
+        const CoarseCells cellsOfP = coarseInside(field, slotsOf[p]);
+        // The halves are fitted without their tenons: the margin takes what the tenons added.
+        Vec3d printer = printerMm;
+        std::sort(printer.begin(), printer.end());  // as fit.extentsMm, shortest side first
+        double overshootMm = 0.0;
+        for (int a = 0; a < 3; ++a)
+            overshootMm = std::max(overshootMm, fit.extentsMm[size_t(a)] - printer[size_t(a)]);
+        const double margin = marginMm + 0.5 * overshootMm;
+        SplitSearch search;
+        search.voxelMm = cellsOfP.cellMm;
+        search.originMm = field.world(Coord(0, 0, 0));
+        search.minVolumeMm3 = minVolumeMm3;
+        const std::optional<SplitPlane> plane =
+            findFitSplit(cellsOfP.centresMm, coarseFit(cellsOfP, printerMm, margin), printerMm,
+                         coarseMarginMm(cellsOfP, margin), search);
+        if (!plane) continue;
+        std::vector<size_t> otherSlots;
+        const uint32_t other =
+            splitPiece(pieces, grouping.cellSets, field, p, *plane, &slotsOf[p], &otherSlots);
+        slotsOf.push_back(std::move(otherSlots));
+        context.detail(
+            formatNumbers("piece %.0f with its tenons is %.1f mm larger than the printer in every "
+                          "orientation: cut in two (%.0f and %.0f)",
+                          double(p), overshootMm, double(p), double(other)));
+        ++cuts;
+    }
+    if (cuts > 0) grouping.faces = faceContacts(field, cells, grouping.cellSets, pieces);
+    return cuts;
 }
 
 size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
@@ -282,10 +392,7 @@ size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField&
                      const RunContext& context) {
     // Each piece's band and inside slots, gathered once (a scan of the whole field per cut is slow
     // at 700 mm).
-    std::vector<std::vector<size_t>> slotsOf(pieces.size());
-    for (size_t s = 0; s < field.phi.size(); ++s)
-        if (field.isActive[s] && field.owner[s] != kNone && field.owner[s] < pieces.size())
-            slotsOf[field.owner[s]].push_back(s);
+    std::vector<std::vector<size_t>> slotsOf = slotsOfPieces(field, pieces.size());
     size_t cuts = 0;
     std::vector<uint32_t> queue(pieces.size());
     for (uint32_t p = 0; p < pieces.size(); ++p) queue[p] = p;

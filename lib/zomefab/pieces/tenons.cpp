@@ -269,15 +269,26 @@ TriMesh pegMesh(const Tenon& t, const TenonOptions& o) {
     return m;
 }
 
-Box3d tenonBoundsMm(const Tenon& t, const TenonOptions& o) {
-    Box3d box;
+std::vector<Vec3d> tenonHullMm(const Tenon& t, const TenonOptions& o) {
     const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
-    // The widest section is the stem's end; the peg is narrower than the stem (checkTenonOptions).
-    const double half = stemHalfWidthMm(o, t.endMm - t.shoulderMm);
-    for (double a : {t.pegTipMm, t.endMm})
+    std::vector<Vec3d> out;
+    auto corners = [&](double along, double half) {
         for (double l : {-half, half})
             for (double s : {-half, half})
-                box.expand(madd(madd(t.pointAt(a), l, t.longSideGrid), s, shortSide));
+                out.push_back(madd(madd(t.pointAt(along), l, t.longSideGrid), s, shortSide));
+    };
+    // The stem's two ends (it tapers toward the ball), then the peg's section at its tip.
+    const double start = t.shoulderMm + kPrismGapMm;
+    corners(start, stemHalfWidthMm(o, start - t.shoulderMm));
+    corners(t.endMm, stemHalfWidthMm(o, t.endMm - t.shoulderMm));
+    for (const auto& q : pegSectionMm(t.hole, o))
+        out.push_back(madd(madd(t.pointAt(t.pegTipMm), q[0], t.longSideGrid), q[1], shortSide));
+    return out;
+}
+
+Box3d tenonBoundsMm(const Tenon& t, const TenonOptions& o) {
+    Box3d box;
+    for (const Vec3d& p : tenonHullMm(t, o)) box.expand(p);
     return box;
 }
 

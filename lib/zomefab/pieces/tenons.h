@@ -113,7 +113,10 @@ double tenonSignedDistanceMm(const Tenon& tenon, const TenonOptions& options, co
 /// 1.5 mm inside the prism to the tip, with a 0.4 mm chamfer round the tip. It overlaps the
 /// meshed prism, as a second shell of the piece's mesh (slicers print the union).
 TriMesh pegMesh(const Tenon& tenon, const TenonOptions& options);
-/// Axis-aligned box (grid mm) around the tenon solid.
+/// Points (grid mm) whose convex hull holds the tenon solid: the corners of the stem's two ends
+/// and the peg's section at its tip (the peg is narrower than the stem's start, checkTenonOptions).
+std::vector<Vec3d> tenonHullMm(const Tenon& tenon, const TenonOptions& options);
+/// Axis-aligned box (grid mm) around the tenon solid (of tenonHullMm).
 Box3d tenonBoundsMm(const Tenon& tenon, const TenonOptions& options);
 
 /// What the planner asks about the shell and its pieces, in the grid's mm. Serial use.

@@ -67,6 +67,32 @@ size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField&
                      bool isRequestFitTrusted, const Vec3d& printerMm, double marginMm, double minVolumeMm3,
                      const RunContext& context);
 
+/// Each piece's active slots (band and inside), in slot order.
+std::vector<std::vector<size_t>> slotsOfPieces(const VoxelField& field, size_t pieceCount);
+
+/// The points of @p points that lie furthest along one of 1,000 directions spread over the sphere:
+/// nearly the vertices of their convex hull, which alone decide a box around them.
+std::vector<Vec3d> extremePoints(const std::vector<Vec3d>& points);
+/// The printer fit of a solid given by @p points (fitInPrinter), searched on extremePoints and
+/// measured on all of them: a strided sample of a wall's voxels misses the hull by a few mm.
+partition::PrinterFit fitOfSolid(const std::vector<Vec3d>& points, const Vec3d& printerMm, double marginMm);
+
+/// Points (grid mm) around each piece's wall: for each inside voxel of the piece and each 6-neighbour
+/// not inside, the point where φ crosses zero on the edge between them (linear, as the mesher's
+/// edge points, among which its vertices lie); for a neighbour inside another piece, that
+/// neighbour's centre (the cut plane lies between the two).
+std::vector<std::vector<Vec3d>> wallSurfaceMm(const VoxelField& field, size_t pieceCount);
+
+/// Cuts every piece whose printed solid, its wall (wallSurfaceMm) with its tenons and pegs
+/// (tenonHullMm), fits @p printerMm in no orientation: the partition and splitTooLarge fit the
+/// surface and the wall, but a tenon reaching in to the frame can add several mm (seen at 700 mm:
+/// 3.8 mm). The plane is findFitSplit's for the piece's coarse cells with @p marginMm grown by half
+/// the overshoot; the caller plans the tenons again. Recomputes @p grouping's faces when it cut.
+/// Returns how many cuts (one per piece at most; a half still too large is cut in a later round).
+size_t splitOverPrinter(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
+                        const GridCells& cells, const TenonOptions& tenons, const Vec3d& printerMm,
+                        double marginMm, double minVolumeMm3, const RunContext& context);
+
 /// A piece's inside voxels (of @p slots) as the centres of cells of about 2 mm or coarser (at most
 /// ~500,000 cells): what the printer-fit tests and the fit cuts run on.
 struct CoarseCells {
