@@ -87,8 +87,8 @@ int main(int argc, char** argv) {
                 std::to_string(r.graphCutPartitions) +
                 formatNumbers(" (w_smoothness %g), ", r.smoothnessWeight) + std::to_string(r.pieces.size()) +
                 " pieces, all fit " +
-                formatNumbers("%gx%gx%g mm", fabrication.printerMm[0], fabrication.printerMm[1],
-                              fabrication.printerMm[2]) +
+                formatNumbers("%gx%gx%g mm (the bed less its margins)", fabrication.pieceBoxMm()[0],
+                              fabrication.pieceBoxMm()[1], fabrication.pieceBoxMm()[2]) +
                 (r.isScheduleBottomedOut ? " (schedule bottomed out: oversized partitions were split)" : ""));
         return 0;
     });

@@ -103,6 +103,7 @@ TEST_CASE("partition: a salient belt across the natural seam is never cut") {
     PartitionOptions o;
     Fabrication fab;
     fab.printerMm = {210, 210, 150};
+    fab.bedMarginMm = 0;  // the printer itself is the box a piece fits (Fabrication::pieceBoxMm)
     std::vector<uint8_t> belt(sphere.triangles.size(), 0);
     for (size_t f = 0; f < belt.size(); ++f) {
         double x = 0;
@@ -169,6 +170,7 @@ TEST_CASE("partition: small bunny, energies, pieces, determinism across thread c
     PartitionOptions o;
     Fabrication fab;
     fab.printerMm = {120, 120, 120};  // forces several pieces on a 300 mm bunny
+    fab.bedMarginMm = 0;              // the printer itself is the box a piece fits (Fabrication::pieceBoxMm)
     const PartitionResult r =
         partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent());
     checkResult(bunny.mesh, r);
@@ -254,6 +256,7 @@ TEST_CASE("partition: when the schedule bottoms out, oversized partitions are sp
     PartitionOptions o;
     Fabrication fab;
     fab.printerMm = {70, 70, 70};
+    fab.bedMarginMm = 0;  // the printer itself is the box a piece fits (Fabrication::pieceBoxMm)
     RunContext quiet;
     const PartitionResult r = partitionSurface(sphere, frame, {0}, fab, o, quiet);
     checkResult(sphere, r);
@@ -287,6 +290,7 @@ TEST_CASE("partition: bad inputs fail with clear messages") {
     fails(frame, {0, 7}, {}, ErrorCode::InvalidInput, "label ball 7 is not a ball of the frame");
     Fabrication tiny;
     tiny.printerMm = {10, 200, 200};
+    tiny.bedMarginMm = 0;
     fails(frame, {0, 1}, {}, ErrorCode::Usage, "smaller than a Zome ball", tiny);
     CHECK_THROWS_AS(checkPartitionOptions({}, tiny), Error);
     // A frame for another mesh: a ball 20 B0 away.
@@ -314,6 +318,7 @@ TEST_CASE("partition: partitions that fit at a high w_smoothness are kept while 
     o.mountBlockedShare = -1.0;  // the printer alone decides what fits (tests/partition/mount_fit_test.cpp)
     Fabrication fab;
     fab.printerMm = {120, 120, 120};
+    fab.bedMarginMm = 0;  // the printer itself is the box a piece fits (Fabrication::pieceBoxMm)
     const PartitionResult r =
         partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent());
     checkResult(bunny.mesh, r);

@@ -91,6 +91,7 @@ TEST_CASE("region merge: the small bunny in a small printer ends with fewer piec
     PartitionOptions o;
     Fabrication fab;
     fab.printerMm = {120, 120, 120};
+    fab.bedMarginMm = 0;
     const PartitionResult merged =
         partitionSurface(bunny.mesh, frame.structure, frame.outermost, fab, o, RunContext::silent());
     PartitionOptions off = o;

@@ -60,7 +60,8 @@ TEST_CASE("zf-partition: bunny in file coordinates, frame with transform_mm") {
     const std::string bytes = readInputBytes(dir.file("p1.json"));
     CHECK(bytes == readInputBytes(dir.file("p2.json")));  // whatever the thread count
     CHECK(readInputBytes(dir.file("err2.txt")).empty());   // -q
-    CHECK(readInputBytes(dir.file("err1.txt")).find("pieces, all fit 150x150x150 mm") != std::string::npos);
+    CHECK(readInputBytes(dir.file("err1.txt"))
+              .find("pieces, all fit 132x132x150 mm (the bed less its margins)") != std::string::npos);
 
     const json j = json::parse(bytes);
     CHECK(j["format"] == "zomefab.partition");
@@ -130,7 +131,14 @@ TEST_CASE("zf-partition: bad inputs exit with the documented codes and write not
     CHECK(readInputBytes(dir.file("e")).find("no_balls_frame.json: the frame has no outermost balls") != std::string::npos);
     CHECK(runTool(mesh + " " + fix + "/far_frame.json -o " + out, dir.file("e")) == 2);
     CHECK(readInputBytes(dir.file("e")).find("frame and mesh do not match") != std::string::npos);
-    CHECK(runTool(mesh + " " + fix + "/far_frame.json -o " + out + " --printer-mm 15x200x200", dir.file("e")) == 1);
+    CHECK(
+        runTool(mesh + " " + fix + "/far_frame.json -o " + out + " --printer-mm 15x200x200 --bed-margin-mm 0",
+                dir.file("e")) == 1);
     CHECK(readInputBytes(dir.file("e")).find("smaller than a Zome ball") != std::string::npos);
+    // A margin that leaves no bed is refused before anything is read.
+    CHECK(runTool(mesh + " " + fix + "/far_frame.json -o " + out + " --printer-mm 15x200x200",
+                  dir.file("e")) == 1);
+    CHECK(readInputBytes(dir.file("e")).find("--bed-margin-mm 9 leaves nothing of the 15 x 200 mm bed") !=
+          std::string::npos);
     CHECK_FALSE(std::ifstream(out).good());
 }

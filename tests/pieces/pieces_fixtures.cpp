@@ -94,6 +94,7 @@ partition::PartitionResult halfSpaceCells(const Vec3d& n, double d) {
 Fabrication printerOf(const Vec3d& printerMm) {
     Fabrication f;
     f.printerMm = printerMm;
+    f.bedMarginMm = 0;
     return f;
 }
 

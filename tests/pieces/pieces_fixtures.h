@@ -29,7 +29,7 @@ partition::PartitionResult quadrantCells(double xMm, double zMm);
 /// Two cells cut by the plane n·x = d (n need not be unit): {n·x ≥ d} is cell 0; one piece each,
 /// marked as fitting (as quadrantCells).
 partition::PartitionResult halfSpaceCells(const Vec3d& n, double d);
-/// A Fabrication with the printer @p printerMm.
+/// A Fabrication with the printer @p printerMm and no bed margin: a piece may take the whole printer.
 Fabrication printerOf(const Vec3d& printerMm);
 
 /// Is @p p inside the closed mesh? (ray parity along a fixed skew direction)

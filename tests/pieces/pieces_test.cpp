@@ -120,8 +120,8 @@ QuadrantPieces quadrantPieces() {
 
 TEST_CASE("pieces: the union of the pieces is the shell (volume and sampled points)") {
     const partition::PartitionResult cells = quadrantCells(-15.3, 20.4);
-    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{},
-                                     plainOptions(), RunContext::silent());
+    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells,
+                                     printerOf({200, 200, 200}), plainOptions(), RunContext::silent());
     REQUIRE(result.pieces.size() == 4);
     checkClosedAndFits(result);
     double total = 0;
@@ -177,8 +177,8 @@ TEST_CASE("pieces: every piece's tenons are parallel, in free holes, their pegs 
     PiecesOptions o;
     o.label.isEnabled = false;
     o.tenons.maxTiltDeg = 35;
-    const Pieces result =
-        makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{}, o, RunContext::silent());
+    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells,
+                                     printerOf({200, 200, 200}), o, RunContext::silent());
     checkClosedAndFits(result);
     CHECK(result.plan.isBuildable());
     const zome::Structure& f = frame();
@@ -237,8 +237,8 @@ TEST_CASE("pieces: every piece's tenons are parallel, in free holes, their pegs 
 TEST_CASE("pieces: slivers are merged into a neighbour, never dropped") {
     // A plane 1.5 mm inside the outer surface cuts off a ~700 mm³ cap of the wall.
     const partition::PartitionResult cells = halfSpaceCells({1, 0, 0}, kRadius - 1.5);
-    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{},
-                                     plainOptions(), RunContext::silent());
+    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells,
+                                     printerOf({200, 200, 200}), plainOptions(), RunContext::silent());
     REQUIRE(result.pieces.size() == 1);
     CHECK(result.sliversMerged == 1);
     CHECK(result.pieces[0].sliversMerged == 1);
@@ -249,8 +249,8 @@ TEST_CASE("pieces: slivers are merged into a neighbour, never dropped") {
     // With no minimum the cap is a piece of its own.
     PiecesOptions keep = plainOptions();
     keep.minPieceVolumeMm3 = 0;
-    const Pieces two = makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{}, keep,
-                                  RunContext::silent());
+    const Pieces two = makePieces(shell(), frame(), Transform4d::identity(), cells,
+                                  printerOf({200, 200, 200}), keep, RunContext::silent());
     REQUIRE(two.pieces.size() == 2);
     CHECK(two.pieces[0].volumeMm3 + two.pieces[1].volumeMm3 == doctest::Approx(shellVolume()).epsilon(0.01));
     CHECK(std::min(two.pieces[0].volumeMm3, two.pieces[1].volumeMm3) < 1500);
@@ -355,7 +355,7 @@ TEST_CASE("pieces: bad inputs and options") {
     auto codeOf = [&](const partition::PartitionResult& c, const PiecesOptions& o,
                       const Transform4d& t = Transform4d::identity()) {
         try {
-            makePieces(shell(), frame(), t, c, Fabrication{}, o, RunContext::silent());
+            makePieces(shell(), frame(), t, c, printerOf({200, 200, 200}), o, RunContext::silent());
         } catch (const Error& e) {
             return int(e.code());
         }
@@ -376,7 +376,7 @@ TEST_CASE("pieces: bad inputs and options") {
     const sdf::LevelSet coarse = makeSphereShell({0, 0, 0}, 60.0, 8.0, 4.0);
     PiecesOptions withTenons;
     try {
-        makePieces(coarse, frame(), Transform4d::identity(), cells, Fabrication{}, withTenons,
+        makePieces(coarse, frame(), Transform4d::identity(), cells, printerOf({200, 200, 200}), withTenons,
                    RunContext::silent());
         FAIL("no error");
     } catch (const Error& e) {
@@ -389,8 +389,8 @@ TEST_CASE("pieces: the engraved number is cut into the inner surface") {
     const partition::PartitionResult cells = halfSpaceCells({0, 0, 1}, 10.0);
     PiecesOptions o;
     o.tenons.maxTiltDeg = 35;
-    const Pieces result =
-        makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{}, o, RunContext::silent());
+    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells,
+                                     printerOf({200, 200, 200}), o, RunContext::silent());
     checkClosedAndFits(result);
     size_t labelled = 0;
     for (const Piece& p : result.pieces) {
@@ -442,7 +442,7 @@ TEST_CASE("pieces: a frame rotated about the vertical and shifted") {
     o.label.isEnabled = false;
     o.tenons.maxTiltDeg = 35;
     const Pieces result =
-        makePieces(shell(), small, frameToGrid, cells, Fabrication{}, o, RunContext::silent());
+        makePieces(shell(), small, frameToGrid, cells, printerOf({200, 200, 200}), o, RunContext::silent());
     // A quadrant too few pegs hold is printed as one with a neighbour (docs/mounting.md, "Merged
     // pieces"): the merged piece holds both quadrants' cells, which the point test below checks.
     REQUIRE(result.pieces.size() + result.mergedPieces == 4);
@@ -493,7 +493,7 @@ TEST_CASE("pieces: the same result with 1 and 2 threads, and the written files")
     o.tenons.maxTiltDeg = 35;
     auto run = [&](int threads) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-        return makePieces(shell(), frame(), Transform4d::identity(), cells, Fabrication{}, o,
+        return makePieces(shell(), frame(), Transform4d::identity(), cells, printerOf({200, 200, 200}), o,
                           RunContext::silent());
     };
     const Pieces one = run(1), two = run(2);
@@ -612,9 +612,9 @@ TEST_CASE("pieces: a piece whose tenon reaches past the printer is cut; the othe
         if (q.field.isActive[s] && q.field.owner[s] < 5) ++after[q.field.owner[s]];
     CHECK(after[0] + after[4] == before[0]);
     for (size_t p = 1; p < 4; ++p) CHECK(after[p] == before[p]);
-    REQUIRE(messages.size() == 1);
-    CHECK(messages[0].find("with its tenons") != std::string::npos);
-    CHECK(messages[0].find("cut in two (0 and 4)") != std::string::npos);
+    REQUIRE(messages.size() == 2);
+    CHECK(messages[0].find("piece 0 with its tenons") != std::string::npos);
+    CHECK(messages[1].find("cut in two (0 and 4)") != std::string::npos);
 }
 
 TEST_CASE("pieces: the fit of a solid is searched on its hull's extremes") {
@@ -638,4 +638,34 @@ TEST_CASE("pieces: the fit of a solid is searched on its hull's extremes") {
     // The box is measured on every point, not on the extremes alone.
     const partition::PrinterFit same = partition::evaluateFit(points, fit.axes, {200, 200, 200}, 1.0);
     CHECK(same.extentsMm[2] == doctest::Approx(fit.extentsMm[2]));
+}
+
+TEST_CASE("pieces: every piece fits the bed less its margins and lies centred on the bed") {
+    // The quadrants (about 100 × 200 × 100 mm each) stand in a 182 × 182 × 200 mm box; with 60 mm
+    // margins (an 80 × 80 mm bed area) each is cut until it fits.
+    const partition::PartitionResult quadrants = quadrantCells(-5.3, 10.4);
+    for (const double marginMm : {9.0, 60.0}) {
+        INFO("margin " << marginMm);
+        Fabrication fab = printerOf({200, 200, 200});
+        fab.bedMarginMm = marginMm;
+        const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), quadrants, fab,
+                                         plainOptions(), RunContext::silent());
+        CHECK(result.pieces.size() >= (marginMm > 10 ? 8u : 4u));
+        for (const Piece& p : result.pieces) {
+            INFO("piece " << p.id);
+            const Box3d box = boundingBox(p.mesh);
+            for (int a = 0; a < 2; ++a) {
+                CHECK(box.min[size_t(a)] >= marginMm - 1e-3);
+                CHECK(box.max[size_t(a)] <= 200.0 - marginMm + 1e-3);
+                CHECK(0.5 * (box.min[size_t(a)] + box.max[size_t(a)]) ==
+                      doctest::Approx(100.0).epsilon(1e-6));
+            }
+            CHECK(box.max[2] <= 200.0 + 1e-3);
+        }
+    }
+    Fabrication none = printerOf({200, 200, 200});
+    none.bedMarginMm = 100;
+    CHECK_THROWS_AS(makePieces(shell(), frame(), Transform4d::identity(), quadrants, none, plainOptions(),
+                               RunContext::silent()),
+                    Error);
 }

@@ -77,7 +77,8 @@ void FabricationCli::addTo(CLI::App& app, unsigned parts) {
                        "Grow each side of a piece's box by this before the fit test")
             ->capture_default_str();
         app.add_option("--bed-margin-mm", f.bedMarginMm,
-                       "Free border on every side of the bed when the pieces are laid out on plates")
+                       "Free border on every side of the bed (mm): every piece fits the bed less it, "
+                       "room for the slicer's supports and a skirt")
             ->capture_default_str();
     }
     if (parts & kWall)

@@ -29,6 +29,12 @@ void requireRange(double value, double lo, double hi, const char* option, const 
 
 }  // namespace
 
+Vec3d pieceBoxMm(const Vec3d& printerMm, double bedMarginMm) {
+    return {printerMm[0] - 2.0 * bedMarginMm, printerMm[1] - 2.0 * bedMarginMm, printerMm[2]};
+}
+
+Vec3d Fabrication::pieceBoxMm() const { return zomefab::pieceBoxMm(printerMm, bedMarginMm); }
+
 void checkFabrication(const Fabrication& f) {
     for (double side : f.printerMm)
         if (!(side > 0.0) || !std::isfinite(side) || side > 10000.0)
@@ -37,6 +43,9 @@ void checkFabrication(const Fabrication& f) {
                             formatNumbers("%g x %g x %g", f.printerMm[0], f.printerMm[1], f.printerMm[2]));
     requireRange(f.fitMarginMm, 0.0, 100.0, "--fit-margin-mm", "mm");
     requireRange(f.bedMarginMm, 0.0, 100.0, "--bed-margin-mm", "mm");
+    if (!(std::min(f.printerMm[0], f.printerMm[1]) > 2.0 * f.bedMarginMm))
+        throw Error(ErrorCode::Usage, formatNumbers("--bed-margin-mm %g leaves nothing of the %g x %g mm bed",
+                                                    f.bedMarginMm, f.printerMm[0], f.printerMm[1]));
     requireRange(f.wallMm, 1.0, 200.0, "--shell-mm", "mm");
     requireRange(f.frameClearanceMm, 0.0, 1000.0, "--frame-clearance-mm", "mm");
     requireRange(f.wallGapMm, 0.0, 100.0, "--wall-gap-mm", "mm");

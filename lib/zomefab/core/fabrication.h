@@ -18,9 +18,12 @@ struct Fabrication {
     /// Every side of a piece's oriented box is grown by this much before the partition's fit test,
     /// for the wall behind the surface and the tenons (mm).
     double fitMarginMm = 2.0;
-    /// Free border kept on every side of the printer's bed when the pieces are laid out on plates,
-    /// mm (a piece too large for it goes alone on a plate, centred).
-    double bedMarginMm = 5.0;
+    /// Free border kept on every side of the printer's bed, mm: every piece is cut to fit the bed
+    /// less this margin (pieceBoxMm) and the plates keep it free. It is room for what a slicer
+    /// prints around a piece: PrusaSlicer 2.5's automatic supports reach up to 5.7 mm beyond a
+    /// piece's footprint (their first layer grows 3 mm, raft_first_layer_expansion), and a skirt
+    /// 2 mm away (Prusa's printer profiles) with its line needs 2.5 mm more (docs/pieces.md, "Plates").
+    double bedMarginMm = 9.0;
     /// Thickness of the printed shell's wall, mm (paper §6: the wall equals its d_min, 16 mm).
     /// Thinner walls (`--shell-mm 4`) print faster and the tenons' tapered stems bridge the gap
     /// to the frame, but on thin meshes fewer pieces then get two tenons (docs/pieces.md).
@@ -43,9 +46,16 @@ struct Fabrication {
     double frameDMinMm() const {
         return frameClearanceMm > wallMm + wallGapMm ? frameClearanceMm : wallMm + wallGapMm;
     }
+    /// The box every printed piece must fit, mm: the bed less bedMarginMm on each side (x, y), the
+    /// printer's full height (z). Pieces may be turned, so the order of the sides does not matter.
+    Vec3d pieceBoxMm() const;
     /// d_max of the forbidden zone (paper §4.3.1): b0, the shortest blue strut, past d_min.
     double frameReachMm() const { return b0Mm > frameDMinMm() ? b0Mm : frameDMinMm() + b0Mm; }
 };
+
+/// The box a piece must fit on a bed of @p printerMm with @p bedMarginMm kept free on each side:
+/// x and y less two margins, the full height (Fabrication::pieceBoxMm).
+Vec3d pieceBoxMm(const Vec3d& printerMm, double bedMarginMm);
 
 /// The random streams of the stages. Each stage draws from its own stream, derived from
 /// Fabrication::seed by seedFor(), so adding randomness to one stage never shifts another's.

@@ -183,7 +183,7 @@ std::vector<Piece> piecesFromCells(const Surface& S, const Classes& C, const Fab
     for (uint32_t p = 0; p < pieceCount; ++p)
         pieces[p] = describePiece(S, C, cells, faceCells, fragOf, pieceFaces[p], cx, piecePts[p]);
     tbb::parallel_for(uint32_t(0), pieceCount, [&](uint32_t p) {
-        pieces[p].fit = fitInPrinter(piecePts[p], fab.printerMm, fab.fitMarginMm);
+        pieces[p].fit = fitInPrinter(piecePts[p], fab.pieceBoxMm(), fab.fitMarginMm);
     });
     return pieces;
 }
@@ -251,9 +251,10 @@ void cutAndMakePieces(const Surface& S, Classes& C, const Fabrication& fab, cons
         // stage cuts those pieces by planes (pieces::detail::splitTooLarge).
         if (!tooLarge.empty() && isLastRound) {
             run.info(std::to_string(tooLarge.size()) + " piece(s) still do not fit the printer " +
-                     sizeText(fab.printerMm) + " after " + std::to_string(round) +
-                     " repair rounds of the planar cuts (piece " + std::to_string(tooLarge.front()) +
-                     " needs " + sizeText(pieces[tooLarge.front()].fit.extentsMm) +
+                     sizeText(fab.pieceBoxMm()) + " (the bed less its margins) after " +
+                     std::to_string(round) + " repair rounds of the planar cuts (piece " +
+                     std::to_string(tooLarge.front()) + " needs " +
+                     sizeText(pieces[tooLarge.front()].fit.extentsMm) +
                      "); the pieces stage cuts them smaller by planes");
             tooLarge.clear();
         }

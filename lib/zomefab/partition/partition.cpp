@@ -22,9 +22,11 @@ using namespace detail;
 void checkPartitionOptions(const PartitionOptions& o, const Fabrication& fab, const zome::ZomeScale& scale) {
     auto usage = [](const std::string& m) { throw Error(ErrorCode::Usage, m); };
     checkFabrication(fab);
-    const double minSide = std::min({fab.printerMm[0], fab.printerMm[1], fab.printerMm[2]});
+    const Vec3d box = fab.pieceBoxMm();
+    const double minSide = std::min({box[0], box[1], box[2]});
     if (minSide < scale.ballDiameterMm + 2.0 * fab.fitMarginMm)
-        usage("printer volume " + sizeText(fab.printerMm) + " is smaller than a Zome ball (" +
+        usage("printer volume " + sizeText(box) +
+              " (the bed less its margins) is smaller than a Zome ball (" +
               formatNumbers("%.1f mm across", scale.ballDiameterMm) +
               (fab.fitMarginMm > 0 ? formatNumbers(" plus 2 x %.1f mm margin", fab.fitMarginMm)
                                    : std::string()) +

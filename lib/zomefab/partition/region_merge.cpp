@@ -39,7 +39,7 @@ void mergeRegions(const Surface& S, const FitTester& fits, const PartitionOption
     const Stopwatch clock;
     std::vector<uint32_t> regionOf;
     const uint32_t regionCount = labelComponents(S.graph, C.trainClass, regionOf);
-    const RegionMerge m = mergeRegionsThatFit(S.mesh, S.graph, regionOf, regionCount, fab.printerMm,
+    const RegionMerge m = mergeRegionsThatFit(S.mesh, S.graph, regionOf, regionCount, fab.pieceBoxMm(),
                                               fab.fitMarginMm, fits.blocked, fits.blockedShare);
     C.faceGroup.resize(S.faceCount);
     for (uint32_t f = 0; f < S.faceCount; ++f) C.faceGroup[f] = m.groupOf[regionOf[f]];

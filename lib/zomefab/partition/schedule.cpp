@@ -57,7 +57,7 @@ std::vector<char> fitsEach(FitTester& cx, const std::vector<std::vector<uint32_t
     for (size_t c = 0; c < n; ++c) pts[c] = faceVertices(cx.mesh, faceSets[c], cx.stamp, cx.stampValue);
     std::vector<char> fits(n, 1);
     tbb::parallel_for(size_t(0), n, [&](size_t c) {
-        fits[c] = cx.isMountable(faceSets[c]) && fitsPrinter(pts[c], cx.fab.printerMm, cx.fab.fitMarginMm);
+        fits[c] = cx.isMountable(faceSets[c]) && fitsPrinter(pts[c], cx.fab.pieceBoxMm(), cx.fab.fitMarginMm);
     });
     return fits;
 }

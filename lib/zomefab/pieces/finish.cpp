@@ -62,7 +62,8 @@ void flattenBase(TriMesh& mesh, const std::vector<CutFace>& faces, const PrintOr
 }  // namespace
 
 std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, const CellSet& set,
-                        const Vec3d& printerMm, double voxel, double seamGapMm, const RunContext& context) {
+                        const Vec3d& printerMm, double bedMarginMm, double voxel, double seamGapMm,
+                        const RunContext& context) {
     // Sealed pockets of a few voxels (seen up to 28 voxels, where a tenon prism meets a tilted
     // wall) would be printed as empty pockets and make admesh count extra parts: fill them. An
     // uncut closed shell keeps its hollow, which is far larger.
@@ -80,8 +81,12 @@ std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, cons
     piece.volumeMm3 = report.volume;
     piece.gridBoundsMm = boundingBox(mesh);
     const std::vector<CutFace> faces = measureCutFaces(mesh, cutPlanes(cells, set, seamGapMm), 0.05 * voxel);
-    const PrintOrientation orientation = orientForPrinter(mesh, faces, printerMm);
-    if (!orientation.fits) failFit(piece, orientation, printerMm);
+    // Oriented within the bed less its margins, then centred on the bed.
+    const Vec3d box = pieceBoxMm(printerMm, bedMarginMm);
+    PrintOrientation orientation = orientForPrinter(mesh, faces, box);
+    if (!orientation.fits) failFit(piece, orientation, box);
+    orientation.transformMm.m[3] += bedMarginMm;
+    orientation.transformMm.m[7] += bedMarginMm;
     piece.gridToPrintMm = orientation.transformMm;  // flattenBase may lift it a few hundredths
     piece.isCutFaceDown = orientation.isCutFaceDown;
     piece.downNormalGridMm = orientation.downNormal;

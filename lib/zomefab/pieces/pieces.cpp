@@ -135,7 +135,7 @@ void meshPieces(Pieces& out, std::vector<PieceGrid>& grids, const GridCells& cel
                 // The pegs as exact meshes, overlapping the meshed prisms (tenons.h, pegMesh).
                 for (const Tenon& t : out.pieces[p].tenons) appendMesh(mesh, pegMesh(t, out.options.tenons));
                 notes[p] = finishPiece(out.pieces[p], std::move(mesh), cells, cellSets[p], out.printerMm,
-                                       voxel, out.options.seamGapMm, context);
+                                       out.bedMarginMm, voxel, out.options.seamGapMm, context);
                 context.progress("pieces", 0.5 + 0.45 * double(++meshed) / double(pieceCount));
             }
         });
@@ -165,7 +165,7 @@ void planTenonsToFit(Pieces& out, VoxelField& field, const GridCells& cells, Gro
                    context);
         if (round == kFitRounds) return;
         const size_t cuts =
-            splitOverPrinter(out.pieces, grouping, field, cells, out.options.tenons, fabrication.printerMm,
+            splitOverPrinter(out.pieces, grouping, field, cells, out.options.tenons, fabrication.pieceBoxMm(),
                              fabrication.fitMarginMm, out.options.minPieceVolumeMm3, context);
         if (cuts == 0) return;
         context.info(std::to_string(cuts) +
@@ -227,9 +227,10 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
                                     out.options.minPieceVolumeMm3, context);
     // What the partition's cells could not make small enough (a cell meeting the surface in one
     // large connected patch) is cut by planes here.
-    const size_t fitCuts = splitTooLarge(grouping.pieces, grouping, field, cells, partition.pieces,
-                                         partition.printerMm == fabrication.printerMm, fabrication.printerMm,
-                                         fabrication.fitMarginMm, out.options.minPieceVolumeMm3, context);
+    const size_t fitCuts =
+        splitTooLarge(grouping.pieces, grouping, field, cells, partition.pieces,
+                      partition.printerMm == fabrication.printerMm, fabrication.pieceBoxMm(),
+                      fabrication.fitMarginMm, out.options.minPieceVolumeMm3, context);
     if (fitCuts > 0)
         context.info(std::to_string(fitCuts) +
                      " cut(s) by planes made the pieces the partition left larger than the printer fit it");

@@ -204,7 +204,7 @@ void mergeUnderHeld(Pieces& out, VoxelField& field, const GridCells& cells, Grou
                     std::set<std::pair<zome::BallId, int>>& lost, const Fabrication& fabrication,
                     const PiecesOptions& opt, const RunContext& context) {
     MergeSearch search;
-    search.printerMm = fabrication.printerMm;
+    search.printerMm = fabrication.pieceBoxMm();
     search.fitMarginMm = fabrication.fitMarginMm;
     search.minPerPiece = opt.tenons.minPerPiece;
     search.maxPerPiece = opt.tenons.maxPerPiece;

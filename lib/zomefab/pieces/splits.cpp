@@ -171,6 +171,18 @@ SplitValue splitValue(const VoxelGraph& g, const std::vector<const TenonCandidat
     return {1, held, held};
 }
 
+/// findFitSplit on a piece's coarse cells (coarseInside) against their fit @p whole (coarseFit
+/// with @p marginMm).
+std::optional<SplitPlane> coarseFitSplit(const VoxelField& field, const CoarseCells& cells,
+                                         const partition::PrinterFit& whole, const Vec3d& printerMm,
+                                         double marginMm, double minVolumeMm3) {
+    SplitSearch search;
+    search.voxelMm = cells.cellMm;
+    search.originMm = field.world(Coord(0, 0, 0));
+    search.minVolumeMm3 = minVolumeMm3;
+    return findFitSplit(cells.centresMm, whole, printerMm, coarseMarginMm(cells, marginMm), search);
+}
+
 }  // namespace
 
 std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
@@ -346,8 +358,28 @@ size_t splitOverPrinter(std::vector<Piece>& pieces, Grouping& grouping, VoxelFie
                         double marginMm, double minVolumeMm3, const RunContext& context) {
     std::vector<std::vector<Vec3d>> points = wallSurfaceMm(field, pieces.size());
     std::vector<std::vector<size_t>> slotsOf;  // gathered at the first cut
-    size_t cuts = 0;
     const size_t pieceCount = pieces.size();
+    Vec3d printer = printerMm;
+    std::sort(printer.begin(), printer.end());  // as a fit's extentsMm, shortest side first
+    // Halves still to test, with the margin their cut was planned with: on their coarse cells
+    // (their tenons are planned again), cut again until they fit, as splitTooLarge.
+    std::vector<std::pair<uint32_t, double>> halves;
+    auto cut = [&](uint32_t p, double margin, const CoarseCells& cellsOfP,
+                   const partition::PrinterFit& whole) {
+        const std::optional<SplitPlane> plane =
+            coarseFitSplit(field, cellsOfP, whole, printerMm, margin, minVolumeMm3);
+        if (!plane) return false;
+        std::vector<size_t> otherSlots;
+        const uint32_t other =
+            splitPiece(pieces, grouping.cellSets, field, p, *plane, &slotsOf[p], &otherSlots);
+        slotsOf.push_back(std::move(otherSlots));
+        halves.push_back({p, margin});
+        halves.push_back({other, margin});
+        context.detail(
+            formatNumbers("piece %.0f: cut in two (%.0f and %.0f)", double(p), double(p), double(other)));
+        return true;
+    };
+    size_t cuts = 0;
     for (uint32_t p = 0; p < pieceCount; ++p) {
         context.throwIfCancelled();
         for (const Tenon& t : pieces[p].tenons)
@@ -356,31 +388,24 @@ size_t splitOverPrinter(std::vector<Piece>& pieces, Grouping& grouping, VoxelFie
         const partition::PrinterFit fit = fitOfSolid(points[p], printerMm, 0.0);
         if (fit.fits) continue;
         if (slotsOf.empty()) slotsOf = slotsOfPieces(field, pieceCount);
-        const CoarseCells cellsOfP = coarseInside(field, slotsOf[p]);
-        // The halves are fitted without their tenons: the margin takes what the tenons added.
-        Vec3d printer = printerMm;
-        std::sort(printer.begin(), printer.end());  // as fit.extentsMm, shortest side first
         double overshootMm = 0.0;
         for (int a = 0; a < 3; ++a)
             overshootMm = std::max(overshootMm, fit.extentsMm[size_t(a)] - printer[size_t(a)]);
-        const double margin = marginMm + 0.5 * overshootMm;
-        SplitSearch search;
-        search.voxelMm = cellsOfP.cellMm;
-        search.originMm = field.world(Coord(0, 0, 0));
-        search.minVolumeMm3 = minVolumeMm3;
-        const std::optional<SplitPlane> plane =
-            findFitSplit(cellsOfP.centresMm, coarseFit(cellsOfP, printerMm, margin), printerMm,
-                         coarseMarginMm(cellsOfP, margin), search);
-        if (!plane) continue;
-        std::vector<size_t> otherSlots;
-        const uint32_t other =
-            splitPiece(pieces, grouping.cellSets, field, p, *plane, &slotsOf[p], &otherSlots);
-        slotsOf.push_back(std::move(otherSlots));
         context.detail(
-            formatNumbers("piece %.0f with its tenons is %.1f mm larger than the printer in every "
-                          "orientation: cut in two (%.0f and %.0f)",
-                          double(p), overshootMm, double(p), double(other)));
-        ++cuts;
+            formatNumbers("piece %.0f with its tenons is %.1f mm larger than the printer's %g x %g x %g "
+                          "mm in every orientation",
+                          double(p), overshootMm, printerMm[0], printerMm[1], printerMm[2]));
+        // The halves are fitted without their tenons: the margin takes what the tenons added.
+        const double margin = marginMm + 0.5 * overshootMm;
+        const CoarseCells cellsOfP = coarseInside(field, slotsOf[p]);
+        cuts += cut(p, margin, cellsOfP, coarseFit(cellsOfP, printerMm, margin)) ? 1 : 0;
+    }
+    for (size_t k = 0; k < halves.size() && cuts < 4 * pieceCount + 64; ++k) {
+        context.throwIfCancelled();
+        const auto [p, margin] = halves[k];
+        const CoarseCells cellsOfP = coarseInside(field, slotsOf[p]);
+        const partition::PrinterFit whole = coarseFit(cellsOfP, printerMm, margin);
+        if (!whole.fits) cuts += cut(p, margin, cellsOfP, whole) ? 1 : 0;
     }
     if (cuts > 0) grouping.faces = faceContacts(field, cells, grouping.cellSets, pieces);
     return cuts;
@@ -411,12 +436,8 @@ size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField&
         const CoarseCells points = coarseInside(field, slotsOf[p]);
         const partition::PrinterFit whole = coarseFit(points, printerMm, marginMm);
         if (whole.fits) continue;
-        SplitSearch search;
-        search.voxelMm = points.cellMm;
-        search.originMm = field.world(Coord(0, 0, 0));
-        search.minVolumeMm3 = minVolumeMm3;
         const std::optional<SplitPlane> plane =
-            findFitSplit(points.centresMm, whole, printerMm, coarseMarginMm(points, marginMm), search);
+            coarseFitSplit(field, points, whole, printerMm, marginMm, minVolumeMm3);
         if (!plane) continue;
         std::vector<size_t> otherSlots;
         const uint32_t other =

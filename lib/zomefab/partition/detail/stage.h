@@ -120,7 +120,7 @@ struct FitTester {
 
     PrinterFit fitOf(const std::vector<uint32_t>& faces) {
         const std::vector<Vec3d> pts = faceVertices(mesh, faces, stamp, stampValue);
-        return fitInPrinter(pts, fab.printerMm, fab.fitMarginMm);
+        return fitInPrinter(pts, fab.pieceBoxMm(), fab.fitMarginMm);
     }
     MountProfile profileOf(const std::vector<uint32_t>& faces) const;
     /// Some hole direction pushes the region's wall off the frame (all but blockedShare of it).

@@ -87,8 +87,9 @@ std::vector<std::vector<Vec3d>> wallSurfaceMm(const VoxelField& field, size_t pi
 /// (tenonHullMm), fits @p printerMm in no orientation: the partition and splitTooLarge fit the
 /// surface and the wall, but a tenon reaching in to the frame can add several mm (seen at 700 mm:
 /// 3.8 mm). The plane is findFitSplit's for the piece's coarse cells with @p marginMm grown by half
-/// the overshoot; the caller plans the tenons again. Recomputes @p grouping's faces when it cut.
-/// Returns how many cuts (one per piece at most; a half still too large is cut in a later round).
+/// the overshoot, and the halves are cut again on their coarse cells until they fit (as
+/// splitTooLarge); the caller plans the tenons again. Recomputes @p grouping's faces when it cut.
+/// Returns how many cuts.
 size_t splitOverPrinter(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
                         const GridCells& cells, const TenonOptions& tenons, const Vec3d& printerMm,
                         double marginMm, double minVolumeMm3, const RunContext& context);
@@ -102,7 +103,7 @@ struct CoarseCells {
 CoarseCells coarseInside(const VoxelField& field, const std::vector<size_t>& slots);
 /// @p marginMm grown by the half diagonal of a cell: the fit margin for the cells' centres.
 double coarseMarginMm(const CoarseCells& cells, double marginMm);
-/// The printer fit of @p cells (fitInPrinter), each box side grown by coarseMarginMm.
+/// The printer fit of @p cells (fitOfSolid), each box side grown by coarseMarginMm.
 partition::PrinterFit coarseFit(const CoarseCells& cells, const Vec3d& printerMm, double marginMm);
 
 /// Cuts piece @p p along @p plane: its voxels beyond the plane (inside and band) go to a new piece
