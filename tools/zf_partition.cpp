@@ -79,6 +79,7 @@ int main(int argc, char** argv) {
             });
         }
         report = partition::partitionSummaryJson(r);
+        const Vec3d box = fabrication.pieceBoxMm();
         cli::printInfo(
             tool,
             meshPath + ": " + std::to_string(mesh.triangles.size()) + " faces, " +
@@ -87,8 +88,7 @@ int main(int argc, char** argv) {
                 std::to_string(r.graphCutPartitions) +
                 formatNumbers(" (w_smoothness %g), ", r.smoothnessWeight) + std::to_string(r.pieces.size()) +
                 " pieces, all fit " +
-                formatNumbers("%gx%gx%g mm (the bed less its margins)", fabrication.pieceBoxMm()[0],
-                              fabrication.pieceBoxMm()[1], fabrication.pieceBoxMm()[2]) +
+                formatNumbers("%gx%gx%g mm (the bed less its margins)", box[0], box[1], box[2]) +
                 (r.isScheduleBottomedOut ? " (schedule bottomed out: oversized partitions were split)" : ""));
         return 0;
     });

@@ -200,13 +200,7 @@ std::vector<Vec3d> facetDirections(const MeshD& m) {
 /// The 6 axis directions, then 250 on a Fibonacci sphere.
 std::vector<Vec3d> sphereDirections() {
     std::vector<Vec3d> directions = {{0, 0, -1}, {0, 0, 1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
-    const int n = 250;
-    for (int i = 0; i < n; ++i) {
-        const double z = 1.0 - (2.0 * i + 1.0) / n;
-        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-        const double phi = i * kPi * (3.0 - std::sqrt(5.0));
-        directions.push_back({r * std::cos(phi), r * std::sin(phi), z});
-    }
+    for (const Vec3d& d : fibonacciSphere(250)) directions.push_back(d);
     return directions;
 }
 

@@ -301,16 +301,12 @@ std::vector<std::vector<size_t>> slotsOfPieces(const VoxelField& field, size_t p
 std::vector<Vec3d> extremePoints(const std::vector<Vec3d>& points) {
     // 1,000 directions on a Fibonacci sphere, about 6.5° apart: a point of the hull between two
     // of their extremes lies within r (1 − cos 3.3°), 0.17 mm at r = 100 mm, of their box sides.
-    constexpr int kDirections = 1000;
     std::vector<uint32_t> chosen;
-    for (int i = 0; i < kDirections; ++i) {
-        const double z = 1.0 - (2.0 * i + 1.0) / kDirections;
-        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-        const double phi = i * kPi * (3.0 - std::sqrt(5.0));
-        const Vec3d d{r * std::cos(phi), r * std::sin(phi), z};
+    for (const Vec3d& d : fibonacciSphere(1000)) {
         uint32_t best = 0;
-        for (uint32_t k = 1; k < points.size(); ++k)
-            if (dot(d, points[k]) > dot(d, points[best])) best = k;
+        double furthest = -1e300;
+        for (uint32_t k = 0; k < points.size(); ++k)
+            if (const double along = dot(d, points[k]); along > furthest) best = k, furthest = along;
         chosen.push_back(best);
     }
     std::sort(chosen.begin(), chosen.end());

@@ -12,6 +12,17 @@ using namespace detail;
 namespace detail {
 
 /// Rows of a rotation taking @p down (unit) to (0, 0, −1).
+std::vector<Vec3d> fibonacciSphere(int count) {
+    std::vector<Vec3d> out;
+    for (int i = 0; i < count; ++i) {
+        const double z = 1.0 - (2.0 * i + 1.0) / count;
+        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+        const double phi = i * kPi * (3.0 - std::sqrt(5.0));
+        out.push_back({r * std::cos(phi), r * std::sin(phi), z});
+    }
+    return out;
+}
+
 std::array<Vec3d, 3> rotationDown(const Vec3d& down) {
     const Vec3d z = scale(down, -1.0);
     // A deterministic perpendicular: cross with the axis least aligned with z.

@@ -31,6 +31,9 @@ struct MeshD {
     }
 };
 
+/// @p count unit directions spread evenly over the sphere (a Fibonacci spiral, z from 1 to −1).
+std::vector<Vec3d> fibonacciSphere(int count);
+
 /// Rows of a rotation taking @p down (unit) to (0, 0, −1): x, y in the bed's plane, z up.
 std::array<Vec3d, 3> rotationDown(const Vec3d& down);
 
