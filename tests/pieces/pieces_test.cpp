@@ -8,6 +8,7 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -429,11 +430,21 @@ TEST_CASE("pieces: the engraved number is cut into the inner surface") {
     CHECK(labelled >= 1);
 }
 
-TEST_CASE("pieces: a frame rotated about the vertical and shifted") {
+namespace {
+
+/// A frame turned 0.3 rad about the vertical and shifted: where it lies in the grid.
+Transform4d turnedFrameToGrid() {
     const double a = 0.3;
     Transform4d frameToGrid;
     frameToGrid.m = {
         std::cos(a), -std::sin(a), 0, 4.0, std::sin(a), std::cos(a), 0, -6.0, 0, 0, 1, 3.0, 0, 0, 0, 1};
+    return frameToGrid;
+}
+
+}  // namespace
+
+TEST_CASE("pieces: a frame rotated about the vertical and shifted") {
+    const Transform4d frameToGrid = turnedFrameToGrid();
     // The shell stays centred at the origin of the grid; the frame (made around its own origin)
     // is placed by frameToGrid, so keep it well inside: a smaller lattice.
     const zome::Structure small = makeCubeLattice(60.0);
@@ -444,7 +455,8 @@ TEST_CASE("pieces: a frame rotated about the vertical and shifted") {
     const Pieces result =
         makePieces(shell(), small, frameToGrid, cells, printerOf({200, 200, 200}), o, RunContext::silent());
     // A quadrant too few pegs hold is printed as one with a neighbour (docs/mounting.md, "Merged
-    // pieces"): the merged piece holds both quadrants' cells, which the point test below checks.
+    // pieces"): the merged piece holds both quadrants' cells, which the point test below checks;
+    // a pair cut anew leaves the count as it was.
     REQUIRE(result.pieces.size() + result.mergedPieces == 4);
     checkClosedAndFits(result);
     size_t total = 0;
@@ -479,11 +491,17 @@ TEST_CASE("pieces: a frame rotated about the vertical and shifted") {
             for (const Tenon& t : p.tenons)
                 if (tenonSignedDistanceMm(t, o.tenons, x) < 1.0) isNearTenon = true;
         if (isNearTenon) continue;
+        // In exactly one piece, one that holds the cell (a pair cut anew by a plane, docs/mounting.md,
+        // shares its cells between its halves).
+        INFO("point " << x[0] << " " << x[1] << " " << x[2] << ", cell " << expected);
+        size_t inside = 0;
         for (size_t k = 0; k < meshes.size(); ++k) {
-            INFO("point " << x[0] << " " << x[1] << " " << x[2] << ", piece " << k);
+            if (!isInsideMesh(meshes[k], x)) continue;
+            ++inside;
             const std::vector<uint32_t>& has = result.pieces[k].cells;
-            CHECK(isInsideMesh(meshes[k], x) == (std::count(has.begin(), has.end(), expected) == 1));
+            CHECK(std::count(has.begin(), has.end(), expected) == 1);
         }
+        CHECK(inside == 1);
     }
 }
 
@@ -668,4 +686,125 @@ TEST_CASE("pieces: every piece fits the bed less its margins and lies centred on
     CHECK_THROWS_AS(makePieces(shell(), frame(), Transform4d::identity(), quadrants, none, plainOptions(),
                                RunContext::silent()),
                     Error);
+}
+
+TEST_CASE("pieces: two under-held neighbours are cut anew along a plane that holds both and fits") {
+    // The union of two pieces: a 200 × 40 × 10 mm slab of 2 mm cells (centres on the cells'
+    // lattice), no frame in the way (every path free). Tenon candidates along one hole at x = −80,
+    // −60, 60 and 80 mm: the plane x = −1 (or x = 19, ...) leaves two to each half, and each half fits a
+    // 130 mm box where the whole slab does not (not even across a diagonal).
+    CoarseCells slab;
+    slab.cellMm = 2.0;
+    for (int i = -50; i < 50; ++i)
+        for (int j = -10; j < 10; ++j)
+            for (int k = -2; k < 3; ++k) slab.centresMm.push_back({2.0 * i, 2.0 * j, 2.0 * k});
+    const zome::Structure none;
+    const FrameSweeps sweeps(none, Transform4d::identity(), Box3d{}, 1.0, 1.0);
+    const int hole = 0;
+    auto candidatesAt = [&](const std::vector<double>& xs) {
+        std::vector<TenonCandidate> out;
+        for (size_t n = 0; n < xs.size(); ++n) {
+            TenonCandidate c;
+            c.piece = 0;
+            c.score = 1.0;
+            c.tenon.ball = zome::BallId(n);
+            c.tenon.hole = hole;
+            c.tenon.axisGrid = zome::holeDirection(hole);
+            c.tenon.ballCenterGridMm = {xs[n], 0.0, 0.0};
+            c.tenon.baseMm = 0.0;
+            out.push_back(c);
+        }
+        return out;
+    };
+    auto pointers = [](const std::vector<TenonCandidate>& list) {
+        std::vector<const TenonCandidate*> out;
+        for (const TenonCandidate& c : list) out.push_back(&c);
+        return out;
+    };
+    SplitSearch search;
+    search.voxelMm = slab.cellMm;
+    search.minVolumeMm3 = 1000.0;
+    search.edgeMarginMm = 6.0;
+    const Vec3d box{130, 130, 130};
+
+    const std::vector<TenonCandidate> even = candidatesAt({-80, -60, 60, 80});
+    REQUIRE_FALSE(fitOfSolid(slab.centresMm, box, 1.0).fits);
+    const std::vector<SplitPlane> planes =
+        findHoldingSplits(slab, pointers(even), sweeps, search, box, 1.0, 2, 3);
+    REQUIRE(!planes.empty());
+    CHECK(planes.size() <= 3);
+    const SplitPlane* plane = &planes[0];
+    size_t beyond = 0;
+    for (const TenonCandidate& c : even) {
+        const double side = dot(plane->normal, c.tenon.pointAt(0.0)) - plane->offsetMm;
+        CHECK(std::abs(side) > search.edgeMarginMm);
+        beyond += side > 0 ? 1 : 0;
+    }
+    CHECK(beyond == 2);  // two on each side
+    // A median plane first (each half has all its two tenons; ties in plane order, the medians
+    // first): through the slab's centre, within a cell.
+    CHECK(std::abs(plane->offsetMm) <= slab.cellMm);
+    const std::vector<SplitPlane> one =
+        findHoldingSplits(slab, pointers(even), sweeps, search, box, 1.0, 2, 1);
+    REQUIRE(one.size() == 1);
+    CHECK(one[0].offsetMm == plane->offsetMm);
+    // Three candidates on one side and one on the other: no plane gives both halves two, one does.
+    const std::vector<TenonCandidate> uneven = candidatesAt({-80, -70, -60, 70});
+    CHECK(findHoldingSplits(slab, pointers(uneven), sweeps, search, box, 1.0, 2, 3).empty());
+    CHECK(!findHoldingSplits(slab, pointers(uneven), sweeps, search, box, 1.0, 1, 3).empty());
+    // Halves that hold but do not fit a 50 mm box are no answer.
+    CHECK(findHoldingSplits(slab, pointers(even), sweeps, search, {50, 50, 50}, 1.0, 2, 3).empty());
+}
+
+TEST_CASE("pieces: the support a half needs lying on its cut face, counted on its cells") {
+    // 2 mm cells. A 20 × 20 mm plate two cells thick standing on the bed needs none; the same
+    // plate lifted so its underside is 10 mm above the bed needs 20 × 20 × 10 mm³; a roof over
+    // a floor needs the space between them only.
+    const double cell = 2.0;
+    auto plate = [&](double z0, int layers) {
+        std::vector<Vec3d> out;
+        for (int i = 0; i < 10; ++i)
+            for (int j = 0; j < 10; ++j)
+                for (int k = 0; k < layers; ++k) out.push_back({cell * i, cell * j, z0 + cell * (k + 0.5)});
+        return out;
+    };
+    const Vec3d up{0, 0, 1};
+    CHECK(restingSupportMm3(plate(0.0, 2), up, 0.0, cell) == doctest::Approx(0.0));
+    CHECK(restingSupportMm3(plate(10.0, 2), up, 0.0, cell) == doctest::Approx(20.0 * 20.0 * 10.0));
+    std::vector<Vec3d> roof = plate(0.0, 1);
+    for (const Vec3d& x : plate(16.0, 1)) roof.push_back(x);
+    CHECK(restingSupportMm3(roof, up, 0.0, cell) == doctest::Approx(20.0 * 20.0 * 14.0));
+    // The bed is the plane up·x = offset, whichever way up points.
+    std::vector<Vec3d> flipped;
+    for (const Vec3d& x : plate(10.0, 2)) flipped.push_back({x[0], x[1], -x[2]});
+    CHECK(restingSupportMm3(flipped, {0, 0, -1}, 0.0, cell) == doctest::Approx(20.0 * 20.0 * 10.0));
+    CHECK(restingSupportMm3(plate(10.0, 2), up, 10.0, cell) == doctest::Approx(0.0));
+}
+
+TEST_CASE("pieces: --recut-pairs cuts an under-held piece anew with a neighbour, so both are held") {
+    // The rotated frame's quadrants (above): with the default, a quadrant stays under two pegs
+    // (no merge fits the printer); with isRecuttingPairs it and a neighbour are cut anew.
+    const Transform4d frameToGrid = turnedFrameToGrid();
+    const zome::Structure small = makeCubeLattice(60.0);
+    const partition::PartitionResult cells = quadrantCells(-15.3, 20.4);
+    PiecesOptions o;
+    o.label.isEnabled = false;
+    auto underHeld = [&](const Pieces& r) {
+        return std::count_if(r.pieces.begin(), r.pieces.end(),
+                             [&](const Piece& p) { return p.tenons.size() < size_t(o.tenons.minPerPiece); });
+    };
+    const Pieces plain =
+        makePieces(shell(), small, frameToGrid, cells, printerOf({200, 200, 200}), o, RunContext::silent());
+    o.isRecuttingPairs = true;
+    const Pieces recut =
+        makePieces(shell(), small, frameToGrid, cells, printerOf({200, 200, 200}), o, RunContext::silent());
+    MESSAGE("under two pegs: " << underHeld(plain) << " of " << plain.pieces.size() << " -> "
+                               << underHeld(recut) << " of " << recut.pieces.size() << ", pairs cut anew "
+                               << recut.recutPairs);
+    CHECK(plain.recutPairs == 0);
+    CHECK(recut.recutPairs > 0);
+    CHECK(underHeld(recut) < underHeld(plain));
+    CHECK(recut.pieces.size() == plain.pieces.size());  // two pieces became two others
+    CHECK(recut.plan.isBuildable());
+    checkClosedAndFits(recut);
 }

@@ -256,6 +256,9 @@ void PiecesCli::addTo(CLI::App& app) {
                    "Balls and struts are taken this much larger when a piece's path is tested")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
+    app.add_flag("--recut-pairs", o.isRecuttingPairs,
+                 "Cut a piece fewer than --min-tenons pegs hold anew with a neighbour so both are held "
+                 "(more pegs, more support to print)");
     app.add_flag("--no-label", isUnlabelled, "Do not engrave piece numbers");
     app.add_option("--label-height-mm", o.label.heightMm, "Height of the engraved digits")
         ->capture_default_str();

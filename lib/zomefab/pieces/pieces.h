@@ -74,6 +74,10 @@ struct PiecesOptions {
     /// larger triangles (tenons and numbers stay at full resolution). 0.3 gives the bunny at 400 mm
     /// 24 MB of STL where 0 gives 121 MB (docs/pieces.md).
     double adaptivity = 0.3;
+    /// Cut a piece too few pegs hold anew with a neighbour, along a plane that gives both halves
+    /// minPerPiece pegs (docs/mounting.md, "Pairs cut anew"). Off by default: the halves print
+    /// with more support (the demo: 12 of 12 pieces on two pegs instead of 10, 6 h more to print).
+    bool isRecuttingPairs = false;
 };
 
 /// @throw Error(Usage) naming the option when a value is out of its documented range.
@@ -138,6 +142,8 @@ struct Pieces {
     /// each adds one piece to what the partition asked for.
     size_t recutPieces = 0;
     size_t mergedPieces = 0;  ///< under-held pieces printed as one with a neighbour (docs/mounting.md)
+    /// Pairs of neighbours cut anew along another plane so that both are held (docs/mounting.md).
+    size_t recutPairs = 0;
     Transform4d frameToGridMm;
     Transform4d gridTransformMm;  ///< the shell's LevelSetInfo::transformMm (input mesh → grid mm)
     PiecesOptions options;

@@ -92,6 +92,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                       {"frame_clearance_mm", o.tenons.frameClearanceMm},
                       {"holes", tenonHolesName(o.tenons.holes)}}},
                     {"seam_gap_mm", o.seamGapMm},
+                    {"recut_pairs", o.isRecuttingPairs},
                     {"pins",
                      {{"diameter_mm", o.pins.diameterMm},
                       {"length_mm", o.pins.lengthMm},
@@ -189,6 +190,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                     {"isolated_slivers", all.isolatedSlivers},
                     {"recut_pieces", all.recutPieces},
                     {"merged_pieces", all.mergedPieces},
+                    {"recut_pairs", all.recutPairs},
                     {"tenons", tenonCount},
                     {"pieces_with_few_tenons", fewTenons},
                     {"labelled", labelled}};

@@ -270,6 +270,7 @@ Pieces piecesFromJson(const json& j, const std::string& directory) {
     out.isolatedSlivers = countFromJson(summary, "isolated_slivers", 0);
     out.recutPieces = countFromJson(summary, "recut_pieces", 0);
     out.mergedPieces = countFromJson(summary, "merged_pieces", 0);
+    out.recutPairs = countFromJson(summary, "recut_pairs", 0);
     return out;
 }
 

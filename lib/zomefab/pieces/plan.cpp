@@ -3,6 +3,8 @@
 #include <openvdb/tools/Interpolation.h>
 
 #include <algorithm>
+#include <cmath>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -183,57 +185,50 @@ size_t underHeld(const std::vector<size_t>& pegs, int minPerPiece) {
     return size_t(std::count_if(pegs.begin(), pegs.end(), [&](size_t n) { return n < size_t(minPerPiece); }));
 }
 
-/// What a merge round changes, kept to undo it.
-struct PlanState {
-    std::vector<Piece> pieces;
-    std::vector<CellSet> cellSets;
-    FaceContacts faces;
-    std::vector<uint32_t> owner;
-    mount::InstallationPlan plan;
-    std::vector<TenonCandidate> candidates;
-    std::set<std::pair<zome::BallId, int>> lost;
-};
+/// Changes to the pieces that are kept only when they help: each is made, the tenons and the plan
+/// made again, and undone unless fewer pieces are under-held (fewer than minPerPiece pegs) and the
+/// plan can be carried out. Merges and pairs cut anew go through it.
+class Replanner {
+public:
+    Replanner(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
+              const ShellProbe& probe, const zome::Structure& frame, const Transform4d& frameToGridMm,
+              const FrameSweeps& sweeps, std::vector<TenonCandidate>& candidates,
+              std::set<std::pair<zome::BallId, int>>& lost, const PiecesOptions& opt,
+              const RunContext& context)
+        : out(out),
+          field(field),
+          cells(cells),
+          grouping(grouping),
+          probe(probe),
+          frame(frame),
+          frameToGridMm(frameToGridMm),
+          sweeps(sweeps),
+          candidates(candidates),
+          lost(lost),
+          opt(opt),
+          context(context) {}
 
-/// Pieces fewer than minPerPiece pegs hold are printed as one with a neighbour (detail/merges.h) and
-/// the plan made again, while that leaves fewer such pieces and a plan that can be carried out. Each
-/// round tries every piece's best merge at once, and when that does not help, the merges one by one
-/// (at most kSingleMergeTrials); a trial that does not help is undone.
-void mergeUnderHeld(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
-                    const ShellProbe& probe, const zome::Structure& frame, const Transform4d& frameToGridMm,
-                    const FrameSweeps& sweeps, std::vector<TenonCandidate>& candidates,
-                    std::set<std::pair<zome::BallId, int>>& lost, const Fabrication& fabrication,
-                    const PiecesOptions& opt, const RunContext& context) {
-    MergeSearch search;
-    search.printerMm = fabrication.pieceBoxMm();
-    search.fitMarginMm = fabrication.fitMarginMm;
-    search.minPerPiece = opt.tenons.minPerPiece;
-    search.maxPerPiece = opt.tenons.maxPerPiece;
-    const int minPegs = opt.tenons.minPerPiece;
-    // Merges @p pairs and plans again; keeps the result when fewer than @p before pieces are
-    // under-held and the plan can be carried out, else undoes it. Returns the new count or 0.
-    auto attempt = [&](const std::vector<std::pair<uint32_t, uint32_t>>& pairs, size_t before) -> size_t {
+    /// The pegs each piece gets along its planned direction.
+    std::vector<size_t> pegs() const { return pegCounts(candidates, out.plan, opt.tenons); }
+    size_t underHeldNow() const { return underHeld(pegs(), opt.tenons.minPerPiece); }
+
+    /// Makes @p change (to the pieces, their cell sets and the voxels' owners), recomputes the
+    /// faces and plans again. Returns the new count of under-held pieces when it is below
+    /// @p before with a plan that can be carried out; else undoes everything and returns nothing.
+    std::optional<size_t> tryChange(const std::function<void()>& change, size_t before,
+                                    const std::string& what) {
         const Stopwatch clock;
-        PlanState kept{out.pieces, grouping.cellSets, grouping.faces, field.owner, out.plan, candidates,
-                       lost};
-        mergeAll(out.pieces, grouping.cellSets, field, pairs);
+        State kept{out.pieces, grouping.cellSets, grouping.faces, field.owner, out.plan, candidates, lost};
+        change();
         grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
         candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
         out.plan = planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context);
-        const size_t after = out.plan.isBuildable()
-                                 ? underHeld(pegCounts(candidates, out.plan, opt.tenons), minPegs)
-                                 : SIZE_MAX;
-        context.debug("mounting: " + std::to_string(pairs.size()) + " merge(s): pieces under " +
-                      std::to_string(minPegs) + " pegs " + std::to_string(before) + " -> " +
+        const size_t after = out.plan.isBuildable() ? underHeldNow() : SIZE_MAX;
+        context.debug("mounting: " + what + ": pieces under " + std::to_string(opt.tenons.minPerPiece) +
+                      " pegs " + std::to_string(before) + " -> " +
                       (after == SIZE_MAX ? std::string("no plan") : std::to_string(after)) + " in " +
                       formatNumber(clock.seconds(), 3) + " s");
-        if (after < before) {
-            out.mergedPieces += pairs.size();
-            context.detail(std::to_string(pairs.size()) +
-                           " piece(s) too few pegs would hold printed as one with a neighbour (" +
-                           std::to_string(before) + " -> " + std::to_string(after) + " pieces under " +
-                           std::to_string(minPegs) + " pegs)");
-            return after;
-        }
+        if (after < before) return after;
         out.pieces = std::move(kept.pieces);
         grouping.cellSets = std::move(kept.cellSets);
         grouping.faces = std::move(kept.faces);
@@ -241,26 +236,163 @@ void mergeUnderHeld(Pieces& out, VoxelField& field, const GridCells& cells, Grou
         out.plan = std::move(kept.plan);
         candidates = std::move(kept.candidates);
         lost = std::move(kept.lost);
-        return 0;
+        return std::nullopt;
+    }
+
+    Pieces& out;
+    VoxelField& field;
+    const GridCells& cells;
+    Grouping& grouping;
+    const ShellProbe& probe;
+    const zome::Structure& frame;
+    const Transform4d& frameToGridMm;
+    const FrameSweeps& sweeps;
+    std::vector<TenonCandidate>& candidates;
+    std::set<std::pair<zome::BallId, int>>& lost;
+    const PiecesOptions& opt;
+    const RunContext& context;
+
+private:
+    /// What a change touches, kept to undo it.
+    struct State {
+        std::vector<Piece> pieces;
+        std::vector<CellSet> cellSets;
+        FaceContacts faces;
+        std::vector<uint32_t> owner;
+        mount::InstallationPlan plan;
+        std::vector<TenonCandidate> candidates;
+        std::set<std::pair<zome::BallId, int>> lost;
     };
-    for (int round = 0; round < kMergeRounds && out.plan.isBuildable(); ++round) {
-        context.throwIfCancelled();
-        const std::vector<size_t> pegs = pegCounts(candidates, out.plan, opt.tenons);
+};
+
+/// Pieces fewer than minPerPiece pegs hold are printed as one with a neighbour (detail/merges.h) and
+/// the plan made again, while that leaves fewer such pieces and a plan that can be carried out. Each
+/// round tries every piece's best merge at once, and when that does not help, the merges one by one
+/// (at most kSingleMergeTrials); a trial that does not help is undone.
+void mergeUnderHeld(Replanner& r, const Fabrication& fabrication) {
+    const PiecesOptions& opt = r.opt;
+    MergeSearch search;
+    search.printerMm = fabrication.pieceBoxMm();
+    search.fitMarginMm = fabrication.fitMarginMm;
+    search.minPerPiece = opt.tenons.minPerPiece;
+    search.maxPerPiece = opt.tenons.maxPerPiece;
+    const int minPegs = opt.tenons.minPerPiece;
+    // Whether merging @p pairs helped (then it is kept).
+    auto attempt = [&](const std::vector<std::pair<uint32_t, uint32_t>>& pairs, size_t before) {
+        const std::optional<size_t> after =
+            r.tryChange([&] { mergeAll(r.out.pieces, r.grouping.cellSets, r.field, pairs); }, before,
+                        std::to_string(pairs.size()) + " merge(s)");
+        if (!after) return false;
+        r.out.mergedPieces += pairs.size();
+        r.context.detail(std::to_string(pairs.size()) +
+                         " piece(s) too few pegs would hold printed as one with a neighbour (" +
+                         std::to_string(before) + " -> " + std::to_string(*after) + " pieces under " +
+                         std::to_string(minPegs) + " pegs)");
+        return true;
+    };
+    for (int round = 0; round < kMergeRounds && r.out.plan.isBuildable(); ++round) {
+        r.context.throwIfCancelled();
+        const std::vector<size_t> pegs = r.pegs();
         const size_t before = underHeld(pegs, minPegs);
         if (before == 0) return;
-        const std::vector<MergeOption> options = mergeOptions(
-            out.pieces, grouping.cellSets, field, pegs, plannerInput(out, field, candidates), sweeps, search);
+        const std::vector<MergeOption> options =
+            mergeOptions(r.out.pieces, r.grouping.cellSets, r.field, pegs,
+                         plannerInput(r.out, r.field, r.candidates), r.sweeps, search);
         const auto batch = disjointMerges(options);
         if (batch.empty()) return;
-        if (attempt(batch, before) > 0) continue;
+        if (attempt(batch, before)) continue;
         bool isMerged = false;
         for (size_t i = 0; i < options.size() && i < kSingleMergeTrials && !isMerged; ++i) {
             if (batch.size() == 1 && batch[0] == std::make_pair(options[i].piece, options[i].neighbor))
                 continue;
-            context.throwIfCancelled();
-            isMerged = attempt({{options[i].piece, options[i].neighbor}}, before) > 0;
+            r.context.throwIfCancelled();
+            isMerged = attempt({{options[i].piece, options[i].neighbor}}, before);
         }
         if (!isMerged) return;
+    }
+}
+
+/// Plane searches and cuts tried per run by recutUnderHeldPairs: each search takes up to 3 s on a
+/// 400 mm bunny's pieces, each trial a plan (about 2 s).
+constexpr size_t kPairSearches = 12;
+constexpr size_t kPairTrials = 8;
+/// Planes tried per pair, best first: a half the search counts two candidates for can lose one to
+/// a neighbour's tenon when the plan is made again, and the next plane may not.
+constexpr size_t kPlanesPerPair = 3;
+
+/// A piece fewer than minPerPiece pegs hold whose union with a neighbour does not fit the printer
+/// (so no merge helps) is cut anew with it: the two become one and are cut again along a plane of
+/// findHoldingSplits, which gives both halves minPerPiece tenons and fits them, and the plan is
+/// made again; kept when fewer pieces are under-held, else the next plane is tried. Smallest under-held piece
+/// first, its neighbours by the largest common face. docs/mounting.md, "Pairs cut anew".
+void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication) {
+    const PiecesOptions& opt = r.opt;
+    const size_t minPegs = size_t(opt.tenons.minPerPiece);
+    SplitSearch search;
+    search.originMm = r.field.world(Coord(0, 0, 0));
+    search.minVolumeMm3 = std::max(opt.minPieceVolumeMm3, 1000.0 * std::pow(r.field.voxelMm, 3));
+    search.edgeMarginMm = bodyRadiusMm(opt.tenons) + r.field.voxelMm;
+    search.maxPerPiece = opt.tenons.maxPerPiece;
+    size_t searches = 0, trials = 0;
+    while (searches < kPairSearches && trials < kPairTrials && r.out.plan.isBuildable()) {
+        const std::vector<size_t> pegs = r.pegs();
+        const size_t before = underHeld(pegs, int(minPegs));
+        if (before == 0) return;
+        std::vector<std::pair<double, uint32_t>> weak;  // (volume, piece): smallest first
+        for (uint32_t p = 0; p < pegs.size(); ++p)
+            if (pegs[p] < minPegs) weak.push_back({r.out.pieces[p].shellVolumeMm3, p});
+        std::sort(weak.begin(), weak.end());
+        const std::vector<std::vector<size_t>> slots = slotsOfPieces(r.field, r.out.pieces.size());
+        bool isCut = false;
+        for (size_t w = 0; w < weak.size() && !isCut && searches < kPairSearches; ++w) {
+            const uint32_t p = weak[w].second;
+            std::vector<std::pair<double, uint32_t>> byFace;  // (−area, neighbour)
+            for (const auto& [q, area] : r.out.pieces[p].neighbors)
+                if (isMergeable(r.grouping.cellSets, p, q)) byFace.push_back({-area, q});
+            std::sort(byFace.begin(), byFace.end());
+            for (size_t k = 0; k < byFace.size() && !isCut && searches < kPairSearches; ++k) {
+                r.context.throwIfCancelled();
+                const uint32_t q = byFace[k].second;
+                std::vector<size_t> both = slots[p];
+                both.insert(both.end(), slots[q].begin(), slots[q].end());
+                const CoarseCells union_ = coarseInside(r.field, both);
+                if (coarseFit(union_, fabrication.pieceBoxMm(), fabrication.fitMarginMm).fits)
+                    continue;  // a merge would do; mergeUnderHeld found it no better
+                std::vector<const TenonCandidate*> mine;
+                for (const TenonCandidate& c : r.candidates)
+                    if (c.rejection.empty() && (c.piece == int64_t(p) || c.piece == int64_t(q)))
+                        mine.push_back(&c);
+                search.voxelMm = union_.cellMm;
+                ++searches;
+                const Stopwatch clock;
+                const std::vector<SplitPlane> planes =
+                    findHoldingSplits(union_, mine, r.sweeps, search, fabrication.pieceBoxMm(),
+                                      fabrication.fitMarginMm, minPegs, kPlanesPerPair);
+                r.context.debug("mounting: pieces " + std::to_string(p) + " and " + std::to_string(q) + ": " +
+                                std::to_string(planes.size()) + " plane(s) that hold both, in " +
+                                formatNumber(clock.seconds(), 3) + " s");
+                const std::string pair = std::to_string(p) + " and " + std::to_string(q);
+                for (size_t k2 = 0; k2 < planes.size() && !isCut && trials < kPairTrials; ++k2) {
+                    ++trials;
+                    const std::optional<size_t> after = r.tryChange(
+                        [&] {
+                            const uint32_t kept = mergePieces(r.out.pieces, r.grouping.cellSets, r.field,
+                                                              std::min(p, q), std::max(p, q));
+                            splitPiece(r.out.pieces, r.grouping.cellSets, r.field, kept, planes[k2]);
+                        },
+                        before, "pieces " + pair + " cut anew");
+                    if (!after) continue;
+                    ++r.out.recutPairs;
+                    r.context.detail("pieces " + pair +
+                                     " cut anew along another plane, so that both are held (" +
+                                     std::to_string(before) + " -> " + std::to_string(*after) +
+                                     " pieces under " + std::to_string(minPegs) + " pegs)");
+                    isCut = true;
+                }
+                if (trials == kPairTrials) return;
+            }
+        }
+        if (!isCut) return;
     }
 }
 
@@ -302,8 +434,10 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
                       " s");
         if (cut == 0) break;
     }
-    mergeUnderHeld(out, field, cells, grouping, probe, frame, frameToGridMm, sweeps, candidates, lost,
-                   fabrication, opt, context);
+    Replanner replanner(out, field, cells, grouping, probe, frame, frameToGridMm, sweeps, candidates, lost,
+                        opt, context);
+    mergeUnderHeld(replanner, fabrication);
+    if (opt.isRecuttingPairs) recutUnderHeldPairs(replanner, fabrication);
     const size_t unpinned = placePins(out, field, cells, grouping.cellSets, opt, GlueOnRule{}.minCosine);
     if (unpinned > 0)
         context.warn(std::to_string(unpinned) + " of " +

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <tuple>
 #include <unordered_map>
 
@@ -18,6 +19,11 @@
 namespace zomefab::pieces::detail {
 
 namespace {
+
+/// Directions of the extremes the fits of findHoldingSplits search on (about 13° apart).
+constexpr int kSearchDirections = 250;
+/// Planes findHoldingSplits fits and compares by their halves' support, best held first.
+constexpr size_t kFittingPlanes = 8;
 
 /// Free directions tested per half, in rank order: the pair that lets the halves be ordered
 /// across their plane is chosen among them.
@@ -171,6 +177,17 @@ SplitValue splitValue(const VoxelGraph& g, const std::vector<const TenonCandidat
     return {1, held, held};
 }
 
+/// The plane of normal @p n through the @p quantile of @p voxels along it, halfway between voxel
+/// centres (of side @p voxelMm), so no voxel lies on it.
+SplitPlane planeAt(const std::vector<Vec3d>& voxels, const Vec3d& n, double quantile, double voxelMm) {
+    std::vector<double> along;
+    along.reserve(voxels.size());
+    for (const Vec3d& x : voxels) along.push_back(dot(n, x));
+    const size_t k = size_t(quantile * double(along.size() - 1));
+    std::nth_element(along.begin(), along.begin() + std::ptrdiff_t(k), along.end());
+    return {n, (std::floor(along[k] / voxelMm) + 0.5) * voxelMm};
+}
+
 /// findFitSplit on a piece's coarse cells (coarseInside) against their fit @p whole (coarseFit
 /// with @p marginMm).
 std::optional<SplitPlane> coarseFitSplit(const VoxelField& field, const CoarseCells& cells,
@@ -185,6 +202,26 @@ std::optional<SplitPlane> coarseFitSplit(const VoxelField& field, const CoarseCe
 
 }  // namespace
 
+double restingSupportMm3(const std::vector<Vec3d>& cells, const Vec3d& up, double offsetMm, double cellMm) {
+    const std::array<Vec3d, 3> rows = rotationDown(scale(up, -1.0));  // rows[2] = up
+    std::unordered_map<int64_t, std::vector<double>> columns;
+    for (const Vec3d& x : cells) {
+        const int64_t i = std::llround(dot(rows[0], x) / cellMm), j = std::llround(dot(rows[1], x) / cellMm);
+        columns[packCell(i, j, 0)].push_back(dot(up, x) - offsetMm);
+    }
+    double gaps = 0.0;
+    for (auto& [key, heights] : columns) {
+        std::sort(heights.begin(), heights.end());
+        double below = 0.0;  // the top of the solid below: the bed first
+        for (const double h : heights) {
+            const double bottom = h - 0.5 * cellMm;
+            if (bottom > below + 0.5 * cellMm) gaps += bottom - below;
+            below = std::max(below, h + 0.5 * cellMm);
+        }
+    }
+    return gaps * cellMm * cellMm;
+}
+
 std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
                                     const std::vector<const TenonCandidate*>& candidates,
                                     const FrameSweeps& sweeps, const SplitSearch& search) {
@@ -194,14 +231,7 @@ std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
     SplitValue bestValue{0, 0, 0};
     for (const double quantile : {0.5, 1.0 / 3.0, 2.0 / 3.0}) {
         for (const Vec3d& n : splitDirections()) {
-            std::vector<double> along;
-            along.reserve(voxels.size());
-            for (const Vec3d& x : voxels) along.push_back(dot(n, x));
-            const size_t k = size_t(quantile * double(along.size() - 1));
-            std::nth_element(along.begin(), along.begin() + std::ptrdiff_t(k), along.end());
-            // Halfway between voxel centres, so no voxel lies on the plane.
-            const double offset = (std::floor(along[k] / search.voxelMm) + 0.5) * search.voxelMm;
-            const SplitPlane plane{n, offset};
+            const SplitPlane plane = planeAt(voxels, n, quantile, search.voxelMm);
             const SplitValue value = splitValue(graph, candidates, plane, sweeps, search);
             if (std::get<0>(value) > 0 && value > bestValue) best = plane, bestValue = value;
         }
@@ -209,6 +239,71 @@ std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
             return best;  // the median planes first: halves of similar size
     }
     return best;
+}
+
+std::vector<SplitPlane> findHoldingSplits(const CoarseCells& cells,
+                                          const std::vector<const TenonCandidate*>& candidates,
+                                          const FrameSweeps& sweeps, const SplitSearch& search,
+                                          const Vec3d& printerMm, double marginMm, size_t minTenons,
+                                          size_t maxPlanes) {
+    const std::vector<Vec3d>& voxels = cells.centresMm;
+    // Each half needs minTenons candidates of its own.
+    if (voxels.size() < 2 || minTenons == 0 || candidates.size() < 2 * minTenons) return {};
+    const VoxelGraph graph = voxelGraph(voxels, search);
+    std::vector<SplitPlane> planes;
+    for (const double quantile : {0.5, 0.4, 0.6, 1.0 / 3.0, 2.0 / 3.0})
+        for (const Vec3d& n : splitDirections())
+            planes.push_back(planeAt(voxels, n, quantile, search.voxelMm));
+    // The tenons first (in parallel: the sweeps are thread-safe), the fit only for planes whose
+    // halves are both held well enough, best first; ties in plane order (deterministic).
+    std::vector<SplitValue> values(planes.size(), {0, 0, 0});
+    tbb::parallel_for(size_t(0), planes.size(), [&](size_t i) {
+        // The candidates each side keeps, per hole, first: most planes leave one side too few
+        // along every hole, and cost no connectivity or path test then.
+        std::array<std::map<int, size_t>, 2> byHole;
+        for (const TenonCandidate* c : candidates) {
+            const double along =
+                dot(planes[i].normal, c->tenon.pointAt(c->tenon.baseMm)) - planes[i].offsetMm;
+            if (std::abs(along) >= search.edgeMarginMm) ++byHole[along > 0 ? 1 : 0][c->tenon.hole];
+        }
+        for (const auto& side : byHole) {
+            size_t most = 0;
+            for (const auto& [hole, count] : side) most = std::max(most, count);
+            if (most < minTenons) return;
+        }
+        values[i] = splitValue(graph, candidates, planes[i], sweeps, search);
+    });
+    // Among the planes that hold both halves well enough, the one with the most tenons first (a
+    // half with only minTenons candidates often loses one to a neighbour's tenon when the plan is
+    // made again); ties in plane order, the median planes first.
+    std::vector<size_t> order;
+    for (size_t i = 0; i < planes.size(); ++i)
+        if (std::get<0>(values[i]) == 2 && std::get<1>(values[i]) >= minTenons) order.push_back(i);
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return values[a] > values[b]; });
+    const double margin = coarseMarginMm(cells, marginMm);
+    std::vector<std::pair<double, size_t>> fitting;  // (support of the halves, plane)
+    for (size_t i : order) {
+        if (fitting.size() == kFittingPlanes) break;
+        std::array<std::vector<Vec3d>, 2> halves;
+        for (const Vec3d& x : voxels) halves[dot(planes[i].normal, x) > planes[i].offsetMm].push_back(x);
+        // Searched on fewer extremes (a box up to a few tenths of a mm from the best can be
+        // missed, never one too small: the box is measured on every cell), as the search
+        // tries many planes; the pieces are fitted again with their tenons (splitOverPrinter).
+        if (!fitOfSolid(halves[0], printerMm, margin, kSearchDirections).fits ||
+            !fitOfSolid(halves[1], printerMm, margin, kSearchDirections).fits)
+            continue;
+        const double support =
+            restingSupportMm3(halves[0], scale(planes[i].normal, -1.0), -planes[i].offsetMm, cells.cellMm) +
+            restingSupportMm3(halves[1], planes[i].normal, planes[i].offsetMm, cells.cellMm);
+        fitting.push_back({support, i});
+    }
+    // The halves that print with the least support first: a plane can leave a half that lies on
+    // no face (on the demo one such cut cost 9 h of print time more than the pair before it).
+    std::stable_sort(fitting.begin(), fitting.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<SplitPlane> out;
+    for (size_t k = 0; k < fitting.size() && k < maxPlanes; ++k) out.push_back(planes[fitting[k].second]);
+    return out;
 }
 
 std::optional<SplitPlane> findFitSplit(const std::vector<Vec3d>& voxels, const partition::PrinterFit& whole,
@@ -298,11 +393,11 @@ std::vector<std::vector<size_t>> slotsOfPieces(const VoxelField& field, size_t p
     return slotsOf;
 }
 
-std::vector<Vec3d> extremePoints(const std::vector<Vec3d>& points) {
+std::vector<Vec3d> extremePoints(const std::vector<Vec3d>& points, int directions) {
     // 1,000 directions on a Fibonacci sphere, about 6.5° apart: a point of the hull between two
     // of their extremes lies within r (1 − cos 3.3°), 0.17 mm at r = 100 mm, of their box sides.
     std::vector<uint32_t> chosen;
-    for (const Vec3d& d : fibonacciSphere(1000)) {
+    for (const Vec3d& d : fibonacciSphere(directions)) {
         uint32_t best = 0;
         double furthest = -1e300;
         for (uint32_t k = 0; k < points.size(); ++k)
@@ -316,11 +411,13 @@ std::vector<Vec3d> extremePoints(const std::vector<Vec3d>& points) {
     return out;
 }
 
-partition::PrinterFit fitOfSolid(const std::vector<Vec3d>& points, const Vec3d& printerMm, double marginMm) {
+partition::PrinterFit fitOfSolid(const std::vector<Vec3d>& points, const Vec3d& printerMm, double marginMm,
+                                 int directions) {
     if (points.empty()) return partition::fitInPrinter(points, printerMm, marginMm);
     // The search on the hull's extremes (fitInPrinter searches on at most 4,096 points, which
     // a strided sample of a wall's voxels leaves a few mm short at the hull), the box on all points.
-    const partition::PrinterFit onHull = partition::fitInPrinter(extremePoints(points), printerMm, marginMm);
+    const partition::PrinterFit onHull =
+        partition::fitInPrinter(extremePoints(points, directions), printerMm, marginMm);
     return partition::evaluateFit(points, onHull.axes, printerMm, marginMm);
 }
 

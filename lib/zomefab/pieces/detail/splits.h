@@ -70,12 +70,13 @@ size_t splitTooLarge(std::vector<Piece>& pieces, Grouping& grouping, VoxelField&
 /// Each piece's active slots (band and inside), in slot order.
 std::vector<std::vector<size_t>> slotsOfPieces(const VoxelField& field, size_t pieceCount);
 
-/// The points of @p points that lie furthest along one of 1,000 directions spread over the sphere:
-/// nearly the vertices of their convex hull, which alone decide a box around them.
-std::vector<Vec3d> extremePoints(const std::vector<Vec3d>& points);
+/// The points of @p points that lie furthest along one of @p directions directions spread over
+/// the sphere: nearly the vertices of their convex hull, which alone decide a box around them.
+std::vector<Vec3d> extremePoints(const std::vector<Vec3d>& points, int directions = 1000);
 /// The printer fit of a solid given by @p points (fitInPrinter), searched on extremePoints and
 /// measured on all of them: a strided sample of a wall's voxels misses the hull by a few mm.
-partition::PrinterFit fitOfSolid(const std::vector<Vec3d>& points, const Vec3d& printerMm, double marginMm);
+partition::PrinterFit fitOfSolid(const std::vector<Vec3d>& points, const Vec3d& printerMm, double marginMm,
+                                 int directions = 1000);
 
 /// Points (grid mm) around each piece's wall: for each inside voxel of the piece and each 6-neighbour
 /// not inside, the point where φ crosses zero on the edge between them (linear, as the mesher's
@@ -105,6 +106,28 @@ CoarseCells coarseInside(const VoxelField& field, const std::vector<size_t>& slo
 double coarseMarginMm(const CoarseCells& cells, double marginMm);
 /// The printer fit of @p cells (fitOfSolid), each box side grown by coarseMarginMm.
 partition::PrinterFit coarseFit(const CoarseCells& cells, const Vec3d& printerMm, double marginMm);
+
+/// The planes that cut two neighbours' union (@p cells: its coarse cells, coarseInside) anew so
+/// that each half has a free direction with at least @p minTenons of @p candidates (the two pieces'
+/// usable ones), ordered across the plane, and fits @p printerMm (each box side grown by
+/// @p marginMm): where the partition's seam left both pieces, or one, under-held, another plane
+/// through their union may hold both. Planes: findSplit's 13 directions through the 33rd, 40th,
+/// 50th, 60th and 67th percentiles. Of the best held (the most tenons in the weaker half, then
+/// both) that fit, up to 8, at most @p maxPlanes are returned, those whose halves need the least
+/// support lying on their new cut face first (restingSupportMm3); the plan made again decides
+/// which helps. @p search.voxelMm
+/// is the cells' side. Empty when no plane does. docs/mounting.md, "Pairs cut anew".
+std::vector<SplitPlane> findHoldingSplits(const CoarseCells& cells,
+                                          const std::vector<const TenonCandidate*>& candidates,
+                                          const FrameSweeps& sweeps, const SplitSearch& search,
+                                          const Vec3d& printerMm, double marginMm, size_t minTenons,
+                                          size_t maxPlanes);
+
+/// The support a half needs printed lying on its cut face, estimated on its cells (of side
+/// @p cellMm): the plane {x : up·x = @p offsetMm} is the bed and @p up (unit) points into the half;
+/// in each column of cells along @p up, the empty space under every solid run down to the solid
+/// below or the bed (the orientation's support columns, on cells), mm³.
+double restingSupportMm3(const std::vector<Vec3d>& cells, const Vec3d& up, double offsetMm, double cellMm);
 
 /// Cuts piece @p p along @p plane: its voxels beyond the plane (inside and band) go to a new piece
 /// with the next id, its cell set with the other half-space; shell volumes recounted. Returns the
