@@ -3,8 +3,8 @@
 #include <openvdb/tools/Interpolation.h>
 
 #include <algorithm>
-#include <cmath>
 #include <functional>
+#include <initializer_list>
 #include <map>
 #include <optional>
 #include <set>
@@ -81,10 +81,10 @@ std::vector<uint32_t> piecesToRecut(const Pieces& out, const PlannerInput& input
     return list;
 }
 
-/// Re-cuts the pieces the plan could not place (piecesToRecut). Returns how many were cut.
-size_t recutBlocked(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
-                    const PlannerInput& input, const std::vector<TenonCandidate>& candidates,
-                    const FrameSweeps& sweeps, const PiecesOptions& opt, const RunContext& context) {
+/// What the re-cuts of a piece (findSplit) and of a pair (findHoldingSplits) need besides the
+/// voxels: the grid, halves of at least the smallest piece volume (and 1,000 voxels), candidates
+/// within a tenon's width of the plane lost; voxelMm is the grid's, for cells the caller sets it.
+SplitSearch splitSearchFor(const VoxelField& field, const PiecesOptions& opt) {
     SplitSearch search;
     search.voxelMm = field.voxelMm;
     search.originMm = field.originMm;
@@ -92,11 +92,28 @@ size_t recutBlocked(Pieces& out, VoxelField& field, const GridCells& cells, Grou
         std::max(opt.minPieceVolumeMm3, 1000.0 * field.voxelMm * field.voxelMm * field.voxelMm);
     search.edgeMarginMm = bodyRadiusMm(opt.tenons) + field.voxelMm;
     search.maxPerPiece = opt.tenons.maxPerPiece;
+    return search;
+}
+
+/// The usable tenon candidates (not rejected) of the pieces @p members.
+std::vector<const TenonCandidate*> usableCandidates(const std::vector<TenonCandidate>& candidates,
+                                                    std::initializer_list<uint32_t> members) {
+    std::vector<const TenonCandidate*> out;
+    for (const TenonCandidate& c : candidates)
+        if (c.rejection.empty() && c.piece >= 0 &&
+            std::find(members.begin(), members.end(), uint32_t(c.piece)) != members.end())
+            out.push_back(&c);
+    return out;
+}
+
+/// Re-cuts the pieces the plan could not place (piecesToRecut). Returns how many were cut.
+size_t recutBlocked(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
+                    const PlannerInput& input, const std::vector<TenonCandidate>& candidates,
+                    const FrameSweeps& sweeps, const PiecesOptions& opt, const RunContext& context) {
+    const SplitSearch search = splitSearchFor(field, opt);
     size_t cut = 0;
     for (uint32_t p : piecesToRecut(out, input, sweeps, field.voxelMm, opt.tenons.maxPerPiece)) {
-        std::vector<const TenonCandidate*> mine;
-        for (const TenonCandidate& c : candidates)
-            if (c.piece == int64_t(p) && c.rejection.empty()) mine.push_back(&c);
+        const std::vector<const TenonCandidate*> mine = usableCandidates(candidates, {p});
         context.throwIfCancelled();
         std::vector<Vec3d> voxels;
         for (size_t s = 0; s < field.phi.size(); ++s)
@@ -323,16 +340,13 @@ constexpr size_t kPlanesPerPair = 3;
 /// A piece fewer than minPerPiece pegs hold whose union with a neighbour does not fit the printer
 /// (so no merge helps) is cut anew with it: the two become one and are cut again along a plane of
 /// findHoldingSplits, which gives both halves minPerPiece tenons and fits them, and the plan is
-/// made again; kept when fewer pieces are under-held, else the next plane is tried. Smallest under-held piece
-/// first, its neighbours by the largest common face. docs/mounting.md, "Pairs cut anew".
+/// made again; kept when fewer pieces are under-held, else the next plane is tried. Smallest
+/// under-held piece first, its neighbours by the largest common face. docs/mounting.md, "Pairs
+/// cut anew".
 void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication) {
     const PiecesOptions& opt = r.opt;
     const size_t minPegs = size_t(opt.tenons.minPerPiece);
-    SplitSearch search;
-    search.originMm = r.field.world(Coord(0, 0, 0));
-    search.minVolumeMm3 = std::max(opt.minPieceVolumeMm3, 1000.0 * std::pow(r.field.voxelMm, 3));
-    search.edgeMarginMm = bodyRadiusMm(opt.tenons) + r.field.voxelMm;
-    search.maxPerPiece = opt.tenons.maxPerPiece;
+    SplitSearch search = splitSearchFor(r.field, opt);  // voxelMm: the union's cells, below
     size_t searches = 0, trials = 0;
     while (searches < kPairSearches && trials < kPairTrials && r.out.plan.isBuildable()) {
         const std::vector<size_t> pegs = r.pegs();
@@ -358,10 +372,7 @@ void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication) {
                 const CoarseCells union_ = coarseInside(r.field, both);
                 if (coarseFit(union_, fabrication.pieceBoxMm(), fabrication.fitMarginMm).fits)
                     continue;  // a merge would do; mergeUnderHeld found it no better
-                std::vector<const TenonCandidate*> mine;
-                for (const TenonCandidate& c : r.candidates)
-                    if (c.rejection.empty() && (c.piece == int64_t(p) || c.piece == int64_t(q)))
-                        mine.push_back(&c);
+                const std::vector<const TenonCandidate*> mine = usableCandidates(r.candidates, {p, q});
                 search.voxelMm = union_.cellMm;
                 ++searches;
                 const Stopwatch clock;

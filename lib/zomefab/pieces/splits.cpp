@@ -99,6 +99,22 @@ bool isConnected(const VoxelGraph& g, const std::vector<uint8_t>& side, uint8_t 
     return queue.size() == count;
 }
 
+/// Per hole, the candidates (count, summed score) that half @p which of @p plane keeps (0: normal·x
+/// ≤ offset, 1: beyond): those whose wall point lies at least edgeMarginMm inside it.
+std::map<int, std::pair<size_t, double>> halfCandidates(const std::vector<const TenonCandidate*>& candidates,
+                                                        const SplitPlane& plane, uint8_t which,
+                                                        const SplitSearch& s) {
+    const double sign = which ? 1.0 : -1.0;
+    std::map<int, std::pair<size_t, double>> byHole;
+    for (const TenonCandidate* c : candidates) {
+        const double along = sign * (dot(plane.normal, c->tenon.pointAt(c->tenon.baseMm)) - plane.offsetMm);
+        if (along < s.edgeMarginMm) continue;
+        byHole[c->tenon.hole].first += 1;
+        byHole[c->tenon.hole].second += c->score;
+    }
+    return byHole;
+}
+
 /// One half as a body: its surface voxels (a neighbour missing or across the cut), the candidates
 /// on its side away from the cut, its options tested along the ranking until the first free one.
 MountBody halfBody(const VoxelGraph& g, const std::vector<uint8_t>& side, uint8_t which,
@@ -114,15 +130,7 @@ MountBody halfBody(const VoxelGraph& g, const std::vector<uint8_t>& side, uint8_
         half.isNearCut.push_back(0);
         half.bounds.expand((*g.voxels)[v]);
     }
-    const double sign = which ? 1.0 : -1.0;
-    std::map<int, std::pair<size_t, double>> byHole;
-    for (const TenonCandidate* c : candidates) {
-        const double along = sign * (dot(plane.normal, c->tenon.pointAt(c->tenon.baseMm)) - plane.offsetMm);
-        if (along < s.edgeMarginMm) continue;
-        byHole[c->tenon.hole].first += 1;
-        byHole[c->tenon.hole].second += c->score;
-    }
-    half.options = rankedOptions(byHole, size_t(s.maxPerPiece));
+    half.options = rankedOptions(halfCandidates(candidates, plane, which, s), size_t(s.maxPerPiece));
     testPaths(half, sweeps, s.voxelMm, kFreeOptionsPerHalf);
     return half;
 }
@@ -260,15 +268,10 @@ std::vector<SplitPlane> findHoldingSplits(const CoarseCells& cells,
     tbb::parallel_for(size_t(0), planes.size(), [&](size_t i) {
         // The candidates each side keeps, per hole, first: most planes leave one side too few
         // along every hole, and cost no connectivity or path test then.
-        std::array<std::map<int, size_t>, 2> byHole;
-        for (const TenonCandidate* c : candidates) {
-            const double along =
-                dot(planes[i].normal, c->tenon.pointAt(c->tenon.baseMm)) - planes[i].offsetMm;
-            if (std::abs(along) >= search.edgeMarginMm) ++byHole[along > 0 ? 1 : 0][c->tenon.hole];
-        }
-        for (const auto& side : byHole) {
+        for (const uint8_t which : {0, 1}) {
             size_t most = 0;
-            for (const auto& [hole, count] : side) most = std::max(most, count);
+            for (const auto& [hole, kept] : halfCandidates(candidates, planes[i], which, search))
+                most = std::max(most, kept.first);
             if (most < minTenons) return;
         }
         values[i] = splitValue(graph, candidates, planes[i], sweeps, search);
@@ -394,8 +397,9 @@ std::vector<std::vector<size_t>> slotsOfPieces(const VoxelField& field, size_t p
 }
 
 std::vector<Vec3d> extremePoints(const std::vector<Vec3d>& points, int directions) {
-    // 1,000 directions on a Fibonacci sphere, about 6.5° apart: a point of the hull between two
-    // of their extremes lies within r (1 − cos 3.3°), 0.17 mm at r = 100 mm, of their box sides.
+    // Directions on a Fibonacci sphere; 1,000 (the default) are about 6.5° apart: a point of the
+    // hull between two of their extremes lies within r (1 − cos 3.3°), 0.17 mm at r = 100 mm, of
+    // their box sides.
     std::vector<uint32_t> chosen;
     for (const Vec3d& d : fibonacciSphere(directions)) {
         uint32_t best = 0;

@@ -115,8 +115,8 @@ partition::PrinterFit coarseFit(const CoarseCells& cells, const Vec3d& printerMm
 /// 50th, 60th and 67th percentiles. Of the best held (the most tenons in the weaker half, then
 /// both) that fit, up to 8, at most @p maxPlanes are returned, those whose halves need the least
 /// support lying on their new cut face first (restingSupportMm3); the plan made again decides
-/// which helps. @p search.voxelMm
-/// is the cells' side. Empty when no plane does. docs/mounting.md, "Pairs cut anew".
+/// which helps. @p search.voxelMm is the cells' side. Empty when no plane does. docs/mounting.md,
+/// "Pairs cut anew".
 std::vector<SplitPlane> findHoldingSplits(const CoarseCells& cells,
                                           const std::vector<const TenonCandidate*>& candidates,
                                           const FrameSweeps& sweeps, const SplitSearch& search,
