@@ -781,23 +781,25 @@ TEST_CASE("pieces: the support a half needs lying on its cut face, counted on it
     CHECK(restingSupportMm3(plate(10.0, 2), up, 10.0, cell) == doctest::Approx(0.0));
 }
 
+/// The rotated frame's quadrants (above) on a 60 mm lattice, made into pieces with @p o: one
+/// quadrant gets fewer than two pegs, and its union with a neighbour does not fit the printer.
+Pieces underHeldQuadrants(const PiecesOptions& o) {
+    return makePieces(shell(), makeCubeLattice(60.0), turnedFrameToGrid(), quadrantCells(-15.3, 20.4),
+                      printerOf({200, 200, 200}), o, RunContext::silent());
+}
+
 TEST_CASE("pieces: --recut-pairs cuts an under-held piece anew with a neighbour, so both are held") {
-    // The rotated frame's quadrants (above): with the default, a quadrant stays under two pegs
-    // (no merge fits the printer); with isRecuttingPairs it and a neighbour are cut anew.
-    const Transform4d frameToGrid = turnedFrameToGrid();
-    const zome::Structure small = makeCubeLattice(60.0);
-    const partition::PartitionResult cells = quadrantCells(-15.3, 20.4);
+    // With the default, a quadrant stays under two pegs (no merge fits the printer); with
+    // isRecuttingPairs it and a neighbour are cut anew.
     PiecesOptions o;
     o.label.isEnabled = false;
     auto underHeld = [&](const Pieces& r) {
         return std::count_if(r.pieces.begin(), r.pieces.end(),
                              [&](const Piece& p) { return p.tenons.size() < size_t(o.tenons.minPerPiece); });
     };
-    const Pieces plain =
-        makePieces(shell(), small, frameToGrid, cells, printerOf({200, 200, 200}), o, RunContext::silent());
+    const Pieces plain = underHeldQuadrants(o);
     o.isRecuttingPairs = true;
-    const Pieces recut =
-        makePieces(shell(), small, frameToGrid, cells, printerOf({200, 200, 200}), o, RunContext::silent());
+    const Pieces recut = underHeldQuadrants(o);
     MESSAGE("under two pegs: " << underHeld(plain) << " of " << plain.pieces.size() << " -> "
                                << underHeld(recut) << " of " << recut.pieces.size() << ", pairs cut anew "
                                << recut.recutPairs);
@@ -807,4 +809,46 @@ TEST_CASE("pieces: --recut-pairs cuts an under-held piece anew with a neighbour,
     CHECK(recut.pieces.size() == plain.pieces.size());  // two pieces became two others
     CHECK(recut.plan.isBuildable());
     checkClosedAndFits(recut);
+}
+
+TEST_CASE("pieces: a piece too few pegs hold is glued to a neighbour before mounting, and the two are held") {
+    // The under-held quadrant glued to a neighbour: the two go on as one body that two pegs or
+    // more hold.
+    PiecesOptions o;
+    o.label.isEnabled = false;
+    auto underHeldSteps = [&](const Pieces& r) {
+        size_t n = 0;
+        for (const mount::MountStep& step : r.plan.steps) {
+            size_t pegs = 0;
+            for (uint32_t p : step.pieces) pegs += r.pieces[p].tenons.size();
+            n += pegs < size_t(o.tenons.minPerPiece) ? 1 : 0;
+        }
+        return n;
+    };
+    o.isGluingUnderHeld = false;
+    const Pieces apart = underHeldQuadrants(o);
+    o.isGluingUnderHeld = true;
+    const Pieces glued = underHeldQuadrants(o);
+    MESSAGE("steps under two pegs: " << underHeldSteps(apart) << " of " << apart.plan.steps.size() << " -> "
+                                     << underHeldSteps(glued) << " of " << glued.plan.steps.size()
+                                     << ", pairs glued " << glued.gluedForPegs);
+    REQUIRE(underHeldSteps(apart) > 0);
+    CHECK(apart.gluedForPegs == 0);
+    CHECK(apart.plan.glued.empty());
+    CHECK(glued.gluedForPegs > 0);
+    CHECK(underHeldSteps(glued) < underHeldSteps(apart));
+    CHECK(glued.plan.steps.size() < apart.plan.steps.size());
+    CHECK(glued.plan.isBuildable());
+    // The glued pieces share a step and its direction, and their pins pair up across the face.
+    REQUIRE(glued.plan.glued.size() == glued.gluedForPegs);
+    for (const auto& [a, b] : glued.plan.glued) {
+        CHECK(glued.plan.stepOf(a) == glued.plan.stepOf(b));
+        CHECK(glued.pieces[a].hole == glued.pieces[b].hole);
+        CHECK(glued.pieces[a].pins.size() + glued.pieces[b].pins.size() > 0);
+    }
+    // Nothing else changes: the same pieces, cut the same way.
+    REQUIRE(glued.pieces.size() == apart.pieces.size());
+    for (size_t p = 0; p < glued.pieces.size(); ++p)
+        CHECK(glued.pieces[p].shellVolumeMm3 == apart.pieces[p].shellVolumeMm3);
+    checkClosedAndFits(glued);
 }

@@ -259,6 +259,8 @@ void PiecesCli::addTo(CLI::App& app) {
     app.add_flag("--recut-pairs", o.isRecuttingPairs,
                  "Cut a piece fewer than --min-tenons pegs hold anew with a neighbour so both are held "
                  "(more pegs, more support to print)");
+    app.add_flag("--no-glue-groups", isNotGluing,
+                 "Do not glue a piece fewer than --min-tenons pegs hold to a neighbour before mounting");
     app.add_flag("--no-label", isUnlabelled, "Do not engrave piece numbers");
     app.add_option("--label-height-mm", o.label.heightMm, "Height of the engraved digits")
         ->capture_default_str();
@@ -268,6 +270,7 @@ void PiecesCli::addTo(CLI::App& app) {
 pieces::PiecesOptions PiecesCli::resolve() const {
     pieces::PiecesOptions o = options;
     o.label.isEnabled = !isUnlabelled;
+    o.isGluingUnderHeld = !isNotGluing;
     o.tenons.holes = *pieces::tenonHolesFromName(tenonHoles);
     pieces::checkPiecesOptions(o);
     return o;

@@ -87,6 +87,7 @@ struct PartitionCli {
 struct PiecesCli {
     pieces::PiecesOptions options;
     bool isUnlabelled = false;
+    bool isNotGluing = false;  ///< --no-glue-groups
     std::string tenonHoles = "all";
 
     void addTo(CLI::App& app);

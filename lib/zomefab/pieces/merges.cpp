@@ -110,15 +110,16 @@ std::vector<MergeOption> mergeOptions(const std::vector<Piece>& pieces, const st
     return out;
 }
 
-std::vector<std::pair<uint32_t, uint32_t>> disjointMerges(const std::vector<MergeOption>& options) {
+std::vector<std::pair<uint32_t, uint32_t>> disjointPairs(
+    const std::vector<std::pair<uint32_t, uint32_t>>& pairs) {
     std::set<uint32_t> used;
-    std::vector<std::pair<uint32_t, uint32_t>> pairs;
-    for (const MergeOption& o : options) {
-        if (used.count(o.piece) || used.count(o.neighbor)) continue;
-        pairs.push_back({o.piece, o.neighbor});
-        used.insert(o.piece), used.insert(o.neighbor);
+    std::vector<std::pair<uint32_t, uint32_t>> out;
+    for (const auto& [a, b] : pairs) {
+        if (used.count(a) || used.count(b)) continue;
+        out.push_back({a, b});
+        used.insert(a), used.insert(b);
     }
-    return pairs;
+    return out;
 }
 
 size_t mergeAll(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field,

@@ -17,10 +17,6 @@ namespace zomefab::pieces::detail {
 
 namespace {
 
-/// A glued group has at most this many pieces: a maker glues a few pieces together, not half the
-/// object (what more gluing would resolve is re-cut instead).
-constexpr size_t kMaxGluedPieces = 4;
-
 /// Could the boxes meet when @p moving is pushed off along @p d past @p still? Their shadows on
 /// the plane normal to d overlap, and something of @p still lies ahead of @p moving's rear.
 bool shadowsMeet(const Box3d& moving, const Box3d& still, const Vec3d& d) {
@@ -465,8 +461,24 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
                                      const FaceContacts& faces, double voxelMm, const std::vector<int>& holes,
                                      int maxPerPiece, const RunContext& context) {
     Bodies bodies;
-    for (const MountBody& piece : input.pieces) {
-        bodies.list.push_back(makeBody(piece.pieces, input, sweeps, voxelMm, maxPerPiece));
+    // Pieces glued before planning start as one body: each pair joins the bodies of its pieces,
+    // glued across the largest face between the two sides.
+    std::vector<uint32_t> bodyOf(input.pieces.size());
+    std::vector<std::vector<uint32_t>> members(input.pieces.size());
+    for (uint32_t p = 0; p < input.pieces.size(); ++p) bodyOf[p] = p, members[p] = {p};
+    for (const auto& [a, b] : input.preGlued) {
+        const uint32_t ba = bodyOf[a], bb = bodyOf[b];
+        if (ba == bb) continue;
+        MountBody sideA, sideB;
+        sideA.pieces = members[ba], sideB.pieces = members[bb];
+        bodies.glued.push_back(gluePair(sideA, sideB, faces));
+        for (uint32_t p : members[bb]) bodyOf[p] = ba;
+        members[ba].insert(members[ba].end(), members[bb].begin(), members[bb].end());
+        members[bb].clear();
+    }
+    for (uint32_t p = 0; p < input.pieces.size(); ++p) {
+        if (members[p].empty()) continue;
+        bodies.list.push_back(makeBody(members[p], input, sweeps, voxelMm, maxPerPiece));
         if (bodies.list.back().isHosted()) addGlueOptions(bodies.list.back(), holes, sweeps, voxelMm);
         context.throwIfCancelled();
     }
@@ -489,7 +501,8 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
     constexpr size_t kGlueStall = 3;
     std::set<std::vector<uint32_t>> noFreeUnion;
     size_t fewestStuck = parts.stuck.size(), stall = 0;
-    for (size_t glues = 0; !parts.stuck.empty() && glues < maxGlues && stall < kGlueStall;) {
+    for (size_t glues = 0;
+         input.isGluingStuck && !parts.stuck.empty() && glues < maxGlues && stall < kGlueStall;) {
         for (size_t k = 0; k < parts.stuck.size(); ++k) {
             std::string in;
             for (uint32_t o : parts.stuckBlockers[k]) in += " " + bodyName(bodies.list[o]);

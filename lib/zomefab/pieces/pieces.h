@@ -78,6 +78,10 @@ struct PiecesOptions {
     /// minPerPiece pegs (docs/mounting.md, "Pairs cut anew"). Off by default: the halves print
     /// with more support (the demo: 12 of 12 pieces on two pegs instead of 10, 6 h more to print).
     bool isRecuttingPairs = false;
+    /// Glue a piece (or glued group) too few pegs hold to a neighbour before mounting, where the two
+    /// go on as one body along a direction whose tenons hold both (docs/mounting.md, "Glued
+    /// groups"). Nothing more to print but alignment pins; the maker glues a few pairs more.
+    bool isGluingUnderHeld = true;
 };
 
 /// @throw Error(Usage) naming the option when a value is out of its documented range.
@@ -144,6 +148,8 @@ struct Pieces {
     size_t mergedPieces = 0;  ///< under-held pieces printed as one with a neighbour (docs/mounting.md)
     /// Pairs of neighbours cut anew along another plane so that both are held (docs/mounting.md).
     size_t recutPairs = 0;
+    /// Pairs glued before mounting because one of them was held by too few pegs (docs/mounting.md).
+    size_t gluedForPegs = 0;
     Transform4d frameToGridMm;
     Transform4d gridTransformMm;  ///< the shell's LevelSetInfo::transformMm (input mesh → grid mm)
     PiecesOptions options;

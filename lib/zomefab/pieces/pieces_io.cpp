@@ -93,6 +93,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                       {"holes", tenonHolesName(o.tenons.holes)}}},
                     {"seam_gap_mm", o.seamGapMm},
                     {"recut_pairs", o.isRecuttingPairs},
+                    {"glue_under_held", o.isGluingUnderHeld},
                     {"pins",
                      {{"diameter_mm", o.pins.diameterMm},
                       {"length_mm", o.pins.lengthMm},
@@ -191,6 +192,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                     {"recut_pieces", all.recutPieces},
                     {"merged_pieces", all.mergedPieces},
                     {"recut_pairs", all.recutPairs},
+                    {"glued_for_pegs", all.gluedForPegs},
                     {"tenons", tenonCount},
                     {"pieces_with_few_tenons", fewTenons},
                     {"labelled", labelled}};

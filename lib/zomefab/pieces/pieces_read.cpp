@@ -271,6 +271,7 @@ Pieces piecesFromJson(const json& j, const std::string& directory) {
     out.recutPieces = countFromJson(summary, "recut_pieces", 0);
     out.mergedPieces = countFromJson(summary, "merged_pieces", 0);
     out.recutPairs = countFromJson(summary, "recut_pairs", 0);
+    out.gluedForPegs = countFromJson(summary, "glued_for_pegs", 0);
     return out;
 }
 

@@ -14,6 +14,7 @@
 #include "zomefab/pieces/detail/merges.h"
 #include "zomefab/pieces/detail/mounting.h"
 #include "zomefab/pieces/detail/pins.h"
+#include "zomefab/pieces/detail/replan.h"
 #include "zomefab/pieces/detail/splits.h"
 #include "zomefab/pieces/detail/stages.h"
 
@@ -46,11 +47,6 @@ void warnShortfall(const Pieces& out, const TenonOptions& o, const RunContext& c
 }
 
 constexpr int kRecutRounds = 5;  ///< plan, re-cut the blocked pieces, plan again: at most this often
-/// Merge under-held pieces, plan again: at most this often (each piece merges once per round; the
-/// elephant at 400 mm merges three specks into one piece in three rounds, 0.7 s each).
-constexpr int kMergeRounds = 8;
-/// When a round's merges together do not help, this many are tried one by one (each a plan).
-constexpr size_t kSingleMergeTrials = 4;
 
 /// The box every piece's voxels and every ball lie in (grid mm): the frame sweeps' rectangle.
 Box3d planBounds(const VoxelField& field, const zome::Structure& frame, const Transform4d& frameToGridMm) {
@@ -79,31 +75,6 @@ std::vector<uint32_t> piecesToRecut(const Pieces& out, const PlannerInput& input
     for (size_t k = 0; k < (stuck.size() + 1) / 2; ++k) list.push_back(stuck[k].second);
     std::sort(list.begin(), list.end());
     return list;
-}
-
-/// What the re-cuts of a piece (findSplit) and of a pair (findHoldingSplits) need besides the
-/// voxels: the grid, halves of at least the smallest piece volume (and 1,000 voxels), candidates
-/// within a tenon's width of the plane lost; voxelMm is the grid's, for cells the caller sets it.
-SplitSearch splitSearchFor(const VoxelField& field, const PiecesOptions& opt) {
-    SplitSearch search;
-    search.voxelMm = field.voxelMm;
-    search.originMm = field.originMm;
-    search.minVolumeMm3 =
-        std::max(opt.minPieceVolumeMm3, 1000.0 * field.voxelMm * field.voxelMm * field.voxelMm);
-    search.edgeMarginMm = bodyRadiusMm(opt.tenons) + field.voxelMm;
-    search.maxPerPiece = opt.tenons.maxPerPiece;
-    return search;
-}
-
-/// The usable tenon candidates (not rejected) of the pieces @p members.
-std::vector<const TenonCandidate*> usableCandidates(const std::vector<TenonCandidate>& candidates,
-                                                    std::initializer_list<uint32_t> members) {
-    std::vector<const TenonCandidate*> out;
-    for (const TenonCandidate& c : candidates)
-        if (c.rejection.empty() && c.piece >= 0 &&
-            std::find(members.begin(), members.end(), uint32_t(c.piece)) != members.end())
-            out.push_back(&c);
-    return out;
 }
 
 /// Re-cuts the pieces the plan could not place (piecesToRecut). Returns how many were cut.
@@ -156,15 +127,41 @@ size_t markLostTenons(const mount::InstallationPlan& plan, const TenonPlan& teno
     return steps;
 }
 
-/// The installation plan over @p candidates, planned again while a step that relies on pegs gets
-/// none (its candidates lost to other pieces' tenons: they are dropped; a few times).
+}  // namespace
+
+SplitSearch splitSearchFor(const VoxelField& field, const PiecesOptions& opt) {
+    SplitSearch search;
+    search.voxelMm = field.voxelMm;
+    search.originMm = field.originMm;
+    search.minVolumeMm3 =
+        std::max(opt.minPieceVolumeMm3, 1000.0 * field.voxelMm * field.voxelMm * field.voxelMm);
+    search.edgeMarginMm = bodyRadiusMm(opt.tenons) + field.voxelMm;
+    search.maxPerPiece = opt.tenons.maxPerPiece;
+    return search;
+}
+
+std::vector<const TenonCandidate*> usableCandidates(const std::vector<TenonCandidate>& candidates,
+                                                    std::initializer_list<uint32_t> members) {
+    std::vector<const TenonCandidate*> out;
+    for (const TenonCandidate& c : candidates)
+        if (c.rejection.empty() && c.piece >= 0 &&
+            std::find(members.begin(), members.end(), uint32_t(c.piece)) != members.end())
+            out.push_back(&c);
+    return out;
+}
+
 mount::InstallationPlan planOverCandidates(const Pieces& out, const VoxelField& field,
                                            const FaceContacts& faces, const FrameSweeps& sweeps,
                                            std::vector<TenonCandidate>& candidates,
                                            std::set<std::pair<zome::BallId, int>>& lost,
-                                           const PiecesOptions& opt, const RunContext& context) {
+                                           const PiecesOptions& opt, const RunContext& context,
+                                           const std::vector<std::pair<uint32_t, uint32_t>>& preGlued) {
     for (int attempt = 0;; ++attempt) {
-        const PlannerInput input = plannerInput(out, field, candidates);
+        PlannerInput input = plannerInput(out, field, candidates);
+        input.preGlued = preGlued;
+        // A plan with glued groups of its own is a trial (glueUnderHeld): it gives up where no order
+        // exists rather than glue more (each round of that took 4 s on the demo, and never helped).
+        input.isGluingStuck = preGlued.empty();
         mount::InstallationPlan plan =
             planMounting(input, sweeps, faces, field.voxelMm, tenonHoleSet(opt.tenons.holes),
                          opt.tenons.maxPerPiece, context);
@@ -177,8 +174,6 @@ mount::InstallationPlan planOverCandidates(const Pieces& out, const VoxelField& 
     }
 }
 
-/// The tenon candidates of the pieces as they are now, those other pieces' tenons took (@p lost)
-/// rejected.
 std::vector<TenonCandidate> freshCandidates(const zome::Structure& frame, const Transform4d& frameToGridMm,
                                             const ShellProbe& probe, const PiecesOptions& opt,
                                             const std::set<std::pair<zome::BallId, int>>& lost) {
@@ -189,7 +184,6 @@ std::vector<TenonCandidate> freshCandidates(const zome::Structure& frame, const 
     return candidates;
 }
 
-/// The pegs each piece gets along its planned direction.
 std::vector<size_t> pegCounts(const std::vector<TenonCandidate>& candidates,
                               const mount::InstallationPlan& plan, const TenonOptions& o) {
     const TenonPlan tenons = chooseTenons(candidates, plan.holeOfPiece, o);
@@ -198,214 +192,7 @@ std::vector<size_t> pegCounts(const std::vector<TenonCandidate>& candidates,
     return pegs;
 }
 
-size_t underHeld(const std::vector<size_t>& pegs, int minPerPiece) {
-    return size_t(std::count_if(pegs.begin(), pegs.end(), [&](size_t n) { return n < size_t(minPerPiece); }));
-}
-
-/// Changes to the pieces that are kept only when they help: each is made, the tenons and the plan
-/// made again, and undone unless fewer pieces are under-held (fewer than minPerPiece pegs) and the
-/// plan can be carried out. Merges and pairs cut anew go through it.
-class Replanner {
-public:
-    Replanner(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
-              const ShellProbe& probe, const zome::Structure& frame, const Transform4d& frameToGridMm,
-              const FrameSweeps& sweeps, std::vector<TenonCandidate>& candidates,
-              std::set<std::pair<zome::BallId, int>>& lost, const PiecesOptions& opt,
-              const RunContext& context)
-        : out(out),
-          field(field),
-          cells(cells),
-          grouping(grouping),
-          probe(probe),
-          frame(frame),
-          frameToGridMm(frameToGridMm),
-          sweeps(sweeps),
-          candidates(candidates),
-          lost(lost),
-          opt(opt),
-          context(context) {}
-
-    /// The pegs each piece gets along its planned direction.
-    std::vector<size_t> pegs() const { return pegCounts(candidates, out.plan, opt.tenons); }
-    size_t underHeldNow() const { return underHeld(pegs(), opt.tenons.minPerPiece); }
-
-    /// Makes @p change (to the pieces, their cell sets and the voxels' owners), recomputes the
-    /// faces and plans again. Returns the new count of under-held pieces when it is below
-    /// @p before with a plan that can be carried out; else undoes everything and returns nothing.
-    std::optional<size_t> tryChange(const std::function<void()>& change, size_t before,
-                                    const std::string& what) {
-        const Stopwatch clock;
-        State kept{out.pieces, grouping.cellSets, grouping.faces, field.owner, out.plan, candidates, lost};
-        change();
-        grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
-        candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
-        out.plan = planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context);
-        const size_t after = out.plan.isBuildable() ? underHeldNow() : SIZE_MAX;
-        context.debug("mounting: " + what + ": pieces under " + std::to_string(opt.tenons.minPerPiece) +
-                      " pegs " + std::to_string(before) + " -> " +
-                      (after == SIZE_MAX ? std::string("no plan") : std::to_string(after)) + " in " +
-                      formatNumber(clock.seconds(), 3) + " s");
-        if (after < before) return after;
-        out.pieces = std::move(kept.pieces);
-        grouping.cellSets = std::move(kept.cellSets);
-        grouping.faces = std::move(kept.faces);
-        field.owner = std::move(kept.owner);
-        out.plan = std::move(kept.plan);
-        candidates = std::move(kept.candidates);
-        lost = std::move(kept.lost);
-        return std::nullopt;
-    }
-
-    Pieces& out;
-    VoxelField& field;
-    const GridCells& cells;
-    Grouping& grouping;
-    const ShellProbe& probe;
-    const zome::Structure& frame;
-    const Transform4d& frameToGridMm;
-    const FrameSweeps& sweeps;
-    std::vector<TenonCandidate>& candidates;
-    std::set<std::pair<zome::BallId, int>>& lost;
-    const PiecesOptions& opt;
-    const RunContext& context;
-
-private:
-    /// What a change touches, kept to undo it.
-    struct State {
-        std::vector<Piece> pieces;
-        std::vector<CellSet> cellSets;
-        FaceContacts faces;
-        std::vector<uint32_t> owner;
-        mount::InstallationPlan plan;
-        std::vector<TenonCandidate> candidates;
-        std::set<std::pair<zome::BallId, int>> lost;
-    };
-};
-
-/// Pieces fewer than minPerPiece pegs hold are printed as one with a neighbour (detail/merges.h) and
-/// the plan made again, while that leaves fewer such pieces and a plan that can be carried out. Each
-/// round tries every piece's best merge at once, and when that does not help, the merges one by one
-/// (at most kSingleMergeTrials); a trial that does not help is undone.
-void mergeUnderHeld(Replanner& r, const Fabrication& fabrication) {
-    const PiecesOptions& opt = r.opt;
-    MergeSearch search;
-    search.printerMm = fabrication.pieceBoxMm();
-    search.fitMarginMm = fabrication.fitMarginMm;
-    search.minPerPiece = opt.tenons.minPerPiece;
-    search.maxPerPiece = opt.tenons.maxPerPiece;
-    const int minPegs = opt.tenons.minPerPiece;
-    // Whether merging @p pairs helped (then it is kept).
-    auto attempt = [&](const std::vector<std::pair<uint32_t, uint32_t>>& pairs, size_t before) {
-        const std::optional<size_t> after =
-            r.tryChange([&] { mergeAll(r.out.pieces, r.grouping.cellSets, r.field, pairs); }, before,
-                        std::to_string(pairs.size()) + " merge(s)");
-        if (!after) return false;
-        r.out.mergedPieces += pairs.size();
-        r.context.detail(std::to_string(pairs.size()) +
-                         " piece(s) too few pegs would hold printed as one with a neighbour (" +
-                         std::to_string(before) + " -> " + std::to_string(*after) + " pieces under " +
-                         std::to_string(minPegs) + " pegs)");
-        return true;
-    };
-    for (int round = 0; round < kMergeRounds && r.out.plan.isBuildable(); ++round) {
-        r.context.throwIfCancelled();
-        const std::vector<size_t> pegs = r.pegs();
-        const size_t before = underHeld(pegs, minPegs);
-        if (before == 0) return;
-        const std::vector<MergeOption> options =
-            mergeOptions(r.out.pieces, r.grouping.cellSets, r.field, pegs,
-                         plannerInput(r.out, r.field, r.candidates), r.sweeps, search);
-        const auto batch = disjointMerges(options);
-        if (batch.empty()) return;
-        if (attempt(batch, before)) continue;
-        bool isMerged = false;
-        for (size_t i = 0; i < options.size() && i < kSingleMergeTrials && !isMerged; ++i) {
-            if (batch.size() == 1 && batch[0] == std::make_pair(options[i].piece, options[i].neighbor))
-                continue;
-            r.context.throwIfCancelled();
-            isMerged = attempt({{options[i].piece, options[i].neighbor}}, before);
-        }
-        if (!isMerged) return;
-    }
-}
-
-/// Plane searches and cuts tried per run by recutUnderHeldPairs: each search takes up to 3 s on a
-/// 400 mm bunny's pieces, each trial a plan (about 2 s).
-constexpr size_t kPairSearches = 12;
-constexpr size_t kPairTrials = 8;
-/// Planes tried per pair, best first: a half the search counts two candidates for can lose one to
-/// a neighbour's tenon when the plan is made again, and the next plane may not.
-constexpr size_t kPlanesPerPair = 3;
-
-/// A piece fewer than minPerPiece pegs hold whose union with a neighbour does not fit the printer
-/// (so no merge helps) is cut anew with it: the two become one and are cut again along a plane of
-/// findHoldingSplits, which gives both halves minPerPiece tenons and fits them, and the plan is
-/// made again; kept when fewer pieces are under-held, else the next plane is tried. Smallest
-/// under-held piece first, its neighbours by the largest common face. docs/mounting.md, "Pairs
-/// cut anew".
-void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication) {
-    const PiecesOptions& opt = r.opt;
-    const size_t minPegs = size_t(opt.tenons.minPerPiece);
-    SplitSearch search = splitSearchFor(r.field, opt);  // voxelMm: the union's cells, below
-    size_t searches = 0, trials = 0;
-    while (searches < kPairSearches && trials < kPairTrials && r.out.plan.isBuildable()) {
-        const std::vector<size_t> pegs = r.pegs();
-        const size_t before = underHeld(pegs, int(minPegs));
-        if (before == 0) return;
-        std::vector<std::pair<double, uint32_t>> weak;  // (volume, piece): smallest first
-        for (uint32_t p = 0; p < pegs.size(); ++p)
-            if (pegs[p] < minPegs) weak.push_back({r.out.pieces[p].shellVolumeMm3, p});
-        std::sort(weak.begin(), weak.end());
-        const std::vector<std::vector<size_t>> slots = slotsOfPieces(r.field, r.out.pieces.size());
-        bool isCut = false;
-        for (size_t w = 0; w < weak.size() && !isCut && searches < kPairSearches; ++w) {
-            const uint32_t p = weak[w].second;
-            std::vector<std::pair<double, uint32_t>> byFace;  // (−area, neighbour)
-            for (const auto& [q, area] : r.out.pieces[p].neighbors)
-                if (isMergeable(r.grouping.cellSets, p, q)) byFace.push_back({-area, q});
-            std::sort(byFace.begin(), byFace.end());
-            for (size_t k = 0; k < byFace.size() && !isCut && searches < kPairSearches; ++k) {
-                r.context.throwIfCancelled();
-                const uint32_t q = byFace[k].second;
-                std::vector<size_t> both = slots[p];
-                both.insert(both.end(), slots[q].begin(), slots[q].end());
-                const CoarseCells union_ = coarseInside(r.field, both);
-                if (coarseFit(union_, fabrication.pieceBoxMm(), fabrication.fitMarginMm).fits)
-                    continue;  // a merge would do; mergeUnderHeld found it no better
-                const std::vector<const TenonCandidate*> mine = usableCandidates(r.candidates, {p, q});
-                search.voxelMm = union_.cellMm;
-                ++searches;
-                const Stopwatch clock;
-                const std::vector<SplitPlane> planes =
-                    findHoldingSplits(union_, mine, r.sweeps, search, fabrication.pieceBoxMm(),
-                                      fabrication.fitMarginMm, minPegs, kPlanesPerPair);
-                r.context.debug("mounting: pieces " + std::to_string(p) + " and " + std::to_string(q) + ": " +
-                                std::to_string(planes.size()) + " plane(s) that hold both, in " +
-                                formatNumber(clock.seconds(), 3) + " s");
-                const std::string pair = std::to_string(p) + " and " + std::to_string(q);
-                for (size_t k2 = 0; k2 < planes.size() && !isCut && trials < kPairTrials; ++k2) {
-                    ++trials;
-                    const std::optional<size_t> after = r.tryChange(
-                        [&] {
-                            const uint32_t kept = mergePieces(r.out.pieces, r.grouping.cellSets, r.field,
-                                                              std::min(p, q), std::max(p, q));
-                            splitPiece(r.out.pieces, r.grouping.cellSets, r.field, kept, planes[k2]);
-                        },
-                        before, "pieces " + pair + " cut anew");
-                    if (!after) continue;
-                    ++r.out.recutPairs;
-                    r.context.detail("pieces " + pair +
-                                     " cut anew along another plane, so that both are held (" +
-                                     std::to_string(before) + " -> " + std::to_string(*after) +
-                                     " pieces under " + std::to_string(minPegs) + " pegs)");
-                    isCut = true;
-                }
-                if (trials == kPairTrials) return;
-            }
-        }
-        if (!isCut) return;
-    }
-}
+namespace {
 
 /// The installation plan, re-cutting blocked pieces and planning again (a few rounds), and the
 /// tenons along each piece's direction.
@@ -449,6 +236,8 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
                         opt, context);
     mergeUnderHeld(replanner, fabrication);
     if (opt.isRecuttingPairs) recutUnderHeldPairs(replanner, fabrication);
+    // Last: glued groups are pairs of piece numbers, which merges and cuts would change.
+    if (opt.isGluingUnderHeld) glueUnderHeld(replanner);
     const size_t unpinned = placePins(out, field, cells, grouping.cellSets, opt, GlueOnRule{}.minCosine);
     if (unpinned > 0)
         context.warn(std::to_string(unpinned) + " of " +

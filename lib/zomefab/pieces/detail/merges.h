@@ -51,8 +51,10 @@ std::vector<MergeOption> mergeOptions(const std::vector<Piece>& pieces, const st
                                       const PlannerInput& input, const FrameSweeps& sweeps,
                                       const MergeSearch& search);
 
-/// The first option of each piece whose pieces are not in an earlier pair, in order.
-std::vector<std::pair<uint32_t, uint32_t>> disjointMerges(const std::vector<MergeOption>& options);
+/// The pairs of @p pairs, in order, that share no member with a pair kept before them: one
+/// merge (or glue) per piece in a round.
+std::vector<std::pair<uint32_t, uint32_t>> disjointPairs(
+    const std::vector<std::pair<uint32_t, uint32_t>>& pairs);
 
 /// Merges every pair of @p pairs (ids as before any of them), in order. Returns how many.
 size_t mergeAll(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field,

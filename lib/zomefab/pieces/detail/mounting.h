@@ -28,6 +28,10 @@ namespace zomefab::pieces::detail {
 /// normal. Their voxels take part in the sweeps between the two instead (a voxel of tolerance).
 inline constexpr size_t kMinOrderFaceVoxels = 50;
 
+/// A glued group has at most this many pieces: a maker glues a few pieces together, not half the
+/// object (what more gluing would resolve is re-cut instead).
+inline constexpr size_t kMaxGluedPieces = 4;
+
 /// One direction a body could take: its hole, the tenons it would get, whether its path is free.
 struct DirectionOption {
     int hole = -1;
@@ -89,6 +93,13 @@ struct PlannerInput {
     std::vector<MountBody> pieces;
     /// Per piece: hole → (usable candidates, summed score).
     std::vector<std::map<int, std::pair<size_t, double>>> candidatesByHole;
+    /// Pairs of pieces whose bodies are glued into one before the planning starts, in this order
+    /// (pieces too few pegs hold glued to a neighbour that holds both: docs/mounting.md, "Glued
+    /// groups"). Empty from plannerInput.
+    std::vector<std::pair<uint32_t, uint32_t>> preGlued;
+    /// Where no order exists, glue stuck bodies in each other's way into one and plan again (a few
+    /// rounds). Off: such a plan is returned stuck at once (a trial that only wants a better plan).
+    bool isGluingStuck = true;
 };
 PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
                           const std::vector<TenonCandidate>& candidates);

@@ -1,0 +1,150 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file Changes to the pieces and their plan that are kept only when they help (internal to
+/// lib/zomefab/pieces): under-held pieces merged with a neighbour, pairs cut anew along a plane,
+/// steps glued to a neighbour before mounting; and what they share with the planning of
+/// pieces/plan.cpp (the plan over the tenon candidates, the pegs it gives). docs/mounting.md.
+#pragma once
+
+#include <functional>
+#include <initializer_list>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "zomefab/core/fabrication.h"
+#include "zomefab/core/run_context.h"
+#include "zomefab/pieces/detail/grouping.h"
+#include "zomefab/pieces/detail/mounting.h"
+#include "zomefab/pieces/detail/splits.h"
+#include "zomefab/pieces/detail/voxels.h"
+#include "zomefab/pieces/pieces.h"
+#include "zomefab/pieces/tenons.h"
+
+namespace zomefab::pieces::detail {
+
+/// What the re-cuts of a piece (findSplit) and of a pair (findHoldingSplits) need besides the
+/// voxels: the grid, halves of at least the smallest piece volume (and 1,000 voxels), candidates
+/// within a tenon's width of the plane lost; voxelMm is the grid's, for cells the caller sets it.
+SplitSearch splitSearchFor(const VoxelField& field, const PiecesOptions& opt);
+
+/// The usable tenon candidates (not rejected) of the pieces @p members.
+std::vector<const TenonCandidate*> usableCandidates(const std::vector<TenonCandidate>& candidates,
+                                                    std::initializer_list<uint32_t> members);
+
+/// The installation plan over @p candidates, planned again while a step that relies on pegs gets
+/// none (its candidates lost to other pieces' tenons: they are dropped; a few times). The pieces
+/// of @p preGlued are glued into one body before planning (PlannerInput::preGlued), and then no
+/// stuck bodies are glued (a trial of glueUnderHeld).
+mount::InstallationPlan planOverCandidates(const Pieces& out, const VoxelField& field,
+                                           const FaceContacts& faces, const FrameSweeps& sweeps,
+                                           std::vector<TenonCandidate>& candidates,
+                                           std::set<std::pair<zome::BallId, int>>& lost,
+                                           const PiecesOptions& opt, const RunContext& context,
+                                           const std::vector<std::pair<uint32_t, uint32_t>>& preGlued = {});
+
+/// The tenon candidates of the pieces as they are now, those other pieces' tenons took (@p lost)
+/// rejected.
+std::vector<TenonCandidate> freshCandidates(const zome::Structure& frame, const Transform4d& frameToGridMm,
+                                            const ShellProbe& probe, const PiecesOptions& opt,
+                                            const std::set<std::pair<zome::BallId, int>>& lost);
+
+/// The pegs each piece gets along its planned direction.
+std::vector<size_t> pegCounts(const std::vector<TenonCandidate>& candidates,
+                              const mount::InstallationPlan& plan, const TenonOptions& o);
+
+/// How many of @p pegs are below @p minPerPiece.
+size_t underHeld(const std::vector<size_t>& pegs, int minPerPiece);
+
+/// The pegs of each step of @p plan: its pieces' pegs summed (a glued group is held by all of them).
+std::vector<size_t> stepPegs(const mount::InstallationPlan& plan, const std::vector<size_t>& pegs);
+
+/// Changes to the pieces that are kept only when they help: each is made, the tenons and the plan
+/// made again, and undone unless fewer pieces are under-held (fewer than minPerPiece pegs) and the
+/// plan can be carried out. Merges and pairs cut anew go through it.
+class Replanner {
+public:
+    Replanner(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
+              const ShellProbe& probe, const zome::Structure& frame, const Transform4d& frameToGridMm,
+              const FrameSweeps& sweeps, std::vector<TenonCandidate>& candidates,
+              std::set<std::pair<zome::BallId, int>>& lost, const PiecesOptions& opt,
+              const RunContext& context)
+        : out(out),
+          field(field),
+          cells(cells),
+          grouping(grouping),
+          probe(probe),
+          frame(frame),
+          frameToGridMm(frameToGridMm),
+          sweeps(sweeps),
+          candidates(candidates),
+          lost(lost),
+          opt(opt),
+          context(context) {}
+
+    /// The pegs each piece gets along its planned direction.
+    std::vector<size_t> pegs() const { return pegCounts(candidates, out.plan, opt.tenons); }
+    size_t underHeldNow() const { return underHeld(pegs(), opt.tenons.minPerPiece); }
+    /// The steps (pieces or glued groups) under minPerPiece pegs.
+    size_t underHeldStepsNow() const { return underHeld(stepPegs(out.plan, pegs()), opt.tenons.minPerPiece); }
+
+    /// Makes @p change (to the pieces, their cell sets and the voxels' owners, or preGlued),
+    /// recomputes the faces and plans again. Returns the new count of under-held pieces (@p steps:
+    /// steps) when it is below @p before with a plan that can be carried out; else undoes
+    /// everything and returns nothing.
+    std::optional<size_t> tryChange(const std::function<void()>& change, size_t before,
+                                    const std::string& what, bool steps = false);
+
+    Pieces& out;
+    VoxelField& field;
+    const GridCells& cells;
+    Grouping& grouping;
+    const ShellProbe& probe;
+    const zome::Structure& frame;
+    const Transform4d& frameToGridMm;
+    const FrameSweeps& sweeps;
+    std::vector<TenonCandidate>& candidates;
+    std::set<std::pair<zome::BallId, int>>& lost;
+    const PiecesOptions& opt;
+    const RunContext& context;
+    /// Pieces glued into one before planning (glueUnderHeld); every plan made here uses them.
+    std::vector<std::pair<uint32_t, uint32_t>> preGlued;
+
+private:
+    /// What a change touches, kept to undo it.
+    struct State {
+        std::vector<Piece> pieces;
+        std::vector<CellSet> cellSets;
+        FaceContacts faces;
+        std::vector<uint32_t> owner;
+        mount::InstallationPlan plan;
+        std::vector<TenonCandidate> candidates;
+        std::set<std::pair<zome::BallId, int>> lost;
+        std::vector<std::pair<uint32_t, uint32_t>> preGlued;
+    };
+};
+
+/// Pieces fewer than minPerPiece pegs hold are printed as one with a neighbour (detail/merges.h) and
+/// the plan made again, while that leaves fewer such pieces and a plan that can be carried out. Each
+/// round tries every piece's best merge at once, and when that does not help, the merges one by one
+/// (at most kSingleMergeTrials); a trial that does not help is undone.
+void mergeUnderHeld(Replanner& r, const Fabrication& fabrication);
+
+/// A piece fewer than minPerPiece pegs hold whose union with a neighbour does not fit the printer
+/// (so no merge helps) is cut anew with it: the two become one and are cut again along a plane of
+/// findHoldingSplits, which gives both halves minPerPiece tenons and fits them, and the plan is
+/// made again; kept when fewer pieces are under-held, else the next plane is tried. Smallest
+/// under-held piece first, its neighbours by the largest common face. docs/mounting.md, "Pairs
+/// cut anew".
+void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication);
+
+/// Steps (pieces or glued groups) fewer than minPerPiece pegs hold, a piece glued on as it goes on
+/// among them, are glued to a neighbouring step before mounting, so the two go on as one body
+/// along a direction whose tenons hold both (docs/mounting.md, "Glued groups"); kept when fewer
+/// steps are under-held with a plan that can be carried out. The pieces themselves do not change
+/// (nothing more to print but the pins). Each round tries every step's best option at once (each
+/// step in one pair), then, when that does not help, the options one by one (kSingleGlueTrials).
+void glueUnderHeld(Replanner& r);
+
+}  // namespace zomefab::pieces::detail

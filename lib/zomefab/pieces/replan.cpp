@@ -1,0 +1,285 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Changes to the pieces kept only when they help: merges, pairs cut anew, glued groups
+// (detail/replan.h, docs/mounting.md).
+#include "zomefab/pieces/detail/replan.h"
+
+#include <algorithm>
+#include <map>
+#include <tuple>
+
+#include "zomefab/core/format.h"
+#include "zomefab/pieces/detail/merges.h"
+
+namespace zomefab::pieces::detail {
+
+size_t underHeld(const std::vector<size_t>& pegs, int minPerPiece) {
+    return size_t(std::count_if(pegs.begin(), pegs.end(), [&](size_t n) { return n < size_t(minPerPiece); }));
+}
+
+std::vector<size_t> stepPegs(const mount::InstallationPlan& plan, const std::vector<size_t>& pegs) {
+    std::vector<size_t> out;
+    for (const mount::MountStep& step : plan.steps) {
+        size_t n = 0;
+        for (uint32_t p : step.pieces) n += pegs[p];
+        out.push_back(n);
+    }
+    return out;
+}
+
+std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, size_t before,
+                                           const std::string& what, bool steps) {
+    const Stopwatch clock;
+    State kept{out.pieces, grouping.cellSets, grouping.faces, field.owner,
+               out.plan,   candidates,        lost,           preGlued};
+    change();
+    grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
+    candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
+    out.plan =
+        planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context, preGlued);
+    const size_t after = !out.plan.isBuildable() ? SIZE_MAX : steps ? underHeldStepsNow() : underHeldNow();
+    context.debug("mounting: " + what + ": " + (steps ? "steps" : "pieces") + " under " +
+                  std::to_string(opt.tenons.minPerPiece) + " pegs " + std::to_string(before) + " -> " +
+                  (after == SIZE_MAX ? std::string("no plan") : std::to_string(after)) + " in " +
+                  formatNumber(clock.seconds(), 3) + " s");
+    if (after < before) return after;
+    out.pieces = std::move(kept.pieces);
+    grouping.cellSets = std::move(kept.cellSets);
+    grouping.faces = std::move(kept.faces);
+    field.owner = std::move(kept.owner);
+    out.plan = std::move(kept.plan);
+    candidates = std::move(kept.candidates);
+    lost = std::move(kept.lost);
+    preGlued = std::move(kept.preGlued);
+    return std::nullopt;
+}
+
+namespace {
+
+using Pairs = std::vector<std::pair<uint32_t, uint32_t>>;
+
+/// The rounds mergeUnderHeld and glueUnderHeld share: each lists the pairs worth trying, best first
+/// (@p listPairs; none: done), tries those that share no member together (disjointPairs) and, when
+/// that does not help (@p attempt returns false: undone), the first @p singles one by one. Stops
+/// after @p rounds, or when a round keeps nothing.
+void tryPairsInRounds(Replanner& r, int rounds, size_t singles, const std::function<Pairs()>& listPairs,
+                      const std::function<bool(const Pairs&)>& attempt) {
+    for (int round = 0; round < rounds && r.out.plan.isBuildable(); ++round) {
+        r.context.throwIfCancelled();
+        const Pairs options = listPairs();
+        const Pairs batch = disjointPairs(options);
+        if (batch.empty()) return;
+        if (attempt(batch)) continue;
+        bool isKept = false;
+        for (size_t i = 0; i < options.size() && i < singles && !isKept; ++i) {
+            if (batch.size() == 1 && batch[0] == options[i]) continue;
+            r.context.throwIfCancelled();
+            isKept = attempt({options[i]});
+        }
+        if (!isKept) return;
+    }
+}
+
+/// Merge under-held pieces, plan again: at most this often (each piece merges once per round; the
+/// elephant at 400 mm merges three specks into one piece in three rounds, 0.7 s each).
+constexpr int kMergeRounds = 8;
+/// When a round's merges together do not help, this many are tried one by one (each a plan).
+constexpr size_t kSingleMergeTrials = 4;
+
+/// Plane searches and cuts tried per run by recutUnderHeldPairs: each search takes up to 3 s on a
+/// 400 mm bunny's pieces, each trial a plan (about 2 s).
+constexpr size_t kPairSearches = 12;
+constexpr size_t kPairTrials = 8;
+/// Planes tried per pair, best first: a half the search counts two candidates for can lose one to
+/// a neighbour's tenon when the plan is made again, and the next plane may not.
+constexpr size_t kPlanesPerPair = 3;
+
+/// Rounds of glueUnderHeld (each a plan; a round glues several pairs at once).
+constexpr int kGlueRounds = 8;
+/// When a round's glues together do not help, this many are tried one by one (each a plan).
+constexpr size_t kSingleGlueTrials = 4;
+
+/// For each step under minPerPiece pegs, the neighbouring steps it could be glued to before
+/// mounting: a common cut face large enough for pins (GlueOnRule::minFaceMm2), at most
+/// kMaxGluedPieces pieces together, and a free direction for the two with more tenon candidates
+/// than the step has pegs and at least minPerPiece. Each step's options best first (most
+/// candidates, then the largest face); steps smallest first.
+Pairs glueUnderHeldOptions(const Replanner& r, const std::vector<size_t>& pegs) {
+    const mount::InstallationPlan& plan = r.out.plan;
+    const size_t minPegs = size_t(r.opt.tenons.minPerPiece);
+    const PlannerInput input = plannerInput(r.out, r.field, r.candidates);
+    const double minFaceVoxels = GlueOnRule{}.minFaceMm2 / (r.field.voxelMm * r.field.voxelMm);
+    std::vector<MountBody> steps(plan.steps.size());
+    std::vector<std::pair<double, size_t>> weak;  // (shell volume, step)
+    for (size_t s = 0; s < plan.steps.size(); ++s) {
+        steps[s].pieces = plan.steps[s].pieces;
+        if (pegs[s] >= minPegs) continue;
+        double volume = 0.0;
+        for (uint32_t p : plan.steps[s].pieces) volume += r.out.pieces[p].shellVolumeMm3;
+        weak.push_back({volume, s});
+    }
+    std::sort(weak.begin(), weak.end());
+    Pairs options;  // (step, neighbour)
+    for (const auto& [volume, s] : weak) {
+        std::vector<std::tuple<size_t, size_t, uint32_t>> mine;  // (−candidates, −contact, neighbour)
+        for (size_t t = 0; t < steps.size(); ++t) {
+            if (t == s || steps[s].pieces.size() + steps[t].pieces.size() > kMaxGluedPieces) continue;
+            const size_t contact = bodyContact(steps[s], steps[t], r.grouping.faces);
+            if (contact == 0 || double(contact) < minFaceVoxels) continue;
+            std::vector<uint32_t> members = steps[s].pieces;
+            members.insert(members.end(), steps[t].pieces.begin(), steps[t].pieces.end());
+            r.context.throwIfCancelled();
+            const MountBody joined =
+                makeBody(members, input, r.sweeps, r.field.voxelMm, r.opt.tenons.maxPerPiece, 1);
+            const DirectionOption* best = joined.bestFree();
+            if (!best || best->tenons < minPegs || best->tenons <= pegs[s]) {
+                r.context.debug("mounting: step " + std::to_string(s) + " glued to step " +
+                                std::to_string(t) + ": " +
+                                (best ? std::to_string(best->tenons) + " tenon candidates at best"
+                                      : std::string("no free direction with tenons")));
+                continue;
+            }
+            mine.push_back({size_t(0) - best->tenons, size_t(0) - contact, uint32_t(t)});
+        }
+        std::sort(mine.begin(), mine.end());
+        for (const auto& [negTenons, negContact, t] : mine) options.push_back({uint32_t(s), t});
+    }
+    return options;
+}
+
+}  // namespace
+
+void mergeUnderHeld(Replanner& r, const Fabrication& fabrication) {
+    const PiecesOptions& opt = r.opt;
+    MergeSearch search;
+    search.printerMm = fabrication.pieceBoxMm();
+    search.fitMarginMm = fabrication.fitMarginMm;
+    search.minPerPiece = opt.tenons.minPerPiece;
+    search.maxPerPiece = opt.tenons.maxPerPiece;
+    const int minPegs = opt.tenons.minPerPiece;
+    // Whether merging @p pairs helped (then it is kept).
+    auto attempt = [&](const Pairs& pairs, size_t before) {
+        const std::optional<size_t> after =
+            r.tryChange([&] { mergeAll(r.out.pieces, r.grouping.cellSets, r.field, pairs); }, before,
+                        std::to_string(pairs.size()) + " merge(s)");
+        if (!after) return false;
+        r.out.mergedPieces += pairs.size();
+        r.context.detail(std::to_string(pairs.size()) +
+                         " piece(s) too few pegs would hold printed as one with a neighbour (" +
+                         std::to_string(before) + " -> " + std::to_string(*after) + " pieces under " +
+                         std::to_string(minPegs) + " pegs)");
+        return true;
+    };
+    size_t before = 0;
+    tryPairsInRounds(
+        r, kMergeRounds, kSingleMergeTrials,
+        [&] {
+            const std::vector<size_t> pegs = r.pegs();
+            before = underHeld(pegs, minPegs);
+            Pairs pairs;
+            if (before == 0) return pairs;
+            for (const MergeOption& o :
+                 mergeOptions(r.out.pieces, r.grouping.cellSets, r.field, pegs,
+                              plannerInput(r.out, r.field, r.candidates), r.sweeps, search))
+                pairs.push_back({o.piece, o.neighbor});
+            return pairs;
+        },
+        [&](const Pairs& pairs) { return attempt(pairs, before); });
+}
+
+void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication) {
+    const PiecesOptions& opt = r.opt;
+    const size_t minPegs = size_t(opt.tenons.minPerPiece);
+    SplitSearch search = splitSearchFor(r.field, opt);  // voxelMm: the union's cells, below
+    size_t searches = 0, trials = 0;
+    while (searches < kPairSearches && trials < kPairTrials && r.out.plan.isBuildable()) {
+        const std::vector<size_t> pegs = r.pegs();
+        const size_t before = underHeld(pegs, int(minPegs));
+        if (before == 0) return;
+        std::vector<std::pair<double, uint32_t>> weak;  // (volume, piece): smallest first
+        for (uint32_t p = 0; p < pegs.size(); ++p)
+            if (pegs[p] < minPegs) weak.push_back({r.out.pieces[p].shellVolumeMm3, p});
+        std::sort(weak.begin(), weak.end());
+        const std::vector<std::vector<size_t>> slots = slotsOfPieces(r.field, r.out.pieces.size());
+        bool isCut = false;
+        for (size_t w = 0; w < weak.size() && !isCut && searches < kPairSearches; ++w) {
+            const uint32_t p = weak[w].second;
+            std::vector<std::pair<double, uint32_t>> byFace;  // (−area, neighbour)
+            for (const auto& [q, area] : r.out.pieces[p].neighbors)
+                if (isMergeable(r.grouping.cellSets, p, q)) byFace.push_back({-area, q});
+            std::sort(byFace.begin(), byFace.end());
+            for (size_t k = 0; k < byFace.size() && !isCut && searches < kPairSearches; ++k) {
+                r.context.throwIfCancelled();
+                const uint32_t q = byFace[k].second;
+                std::vector<size_t> both = slots[p];
+                both.insert(both.end(), slots[q].begin(), slots[q].end());
+                const CoarseCells union_ = coarseInside(r.field, both);
+                if (coarseFit(union_, fabrication.pieceBoxMm(), fabrication.fitMarginMm).fits)
+                    continue;  // a merge would do; mergeUnderHeld found it no better
+                const std::vector<const TenonCandidate*> mine = usableCandidates(r.candidates, {p, q});
+                search.voxelMm = union_.cellMm;
+                ++searches;
+                const Stopwatch clock;
+                const std::vector<SplitPlane> planes =
+                    findHoldingSplits(union_, mine, r.sweeps, search, fabrication.pieceBoxMm(),
+                                      fabrication.fitMarginMm, minPegs, kPlanesPerPair);
+                r.context.debug("mounting: pieces " + std::to_string(p) + " and " + std::to_string(q) + ": " +
+                                std::to_string(planes.size()) + " plane(s) that hold both, in " +
+                                formatNumber(clock.seconds(), 3) + " s");
+                const std::string pair = std::to_string(p) + " and " + std::to_string(q);
+                for (size_t k2 = 0; k2 < planes.size() && !isCut && trials < kPairTrials; ++k2) {
+                    ++trials;
+                    const std::optional<size_t> after = r.tryChange(
+                        [&] {
+                            const uint32_t kept = mergePieces(r.out.pieces, r.grouping.cellSets, r.field,
+                                                              std::min(p, q), std::max(p, q));
+                            splitPiece(r.out.pieces, r.grouping.cellSets, r.field, kept, planes[k2]);
+                        },
+                        before, "pieces " + pair + " cut anew");
+                    if (!after) continue;
+                    ++r.out.recutPairs;
+                    r.context.detail("pieces " + pair +
+                                     " cut anew along another plane, so that both are held (" +
+                                     std::to_string(before) + " -> " + std::to_string(*after) +
+                                     " pieces under " + std::to_string(minPegs) + " pegs)");
+                    isCut = true;
+                }
+                if (trials == kPairTrials) return;
+            }
+        }
+        if (!isCut) return;
+    }
+}
+
+void glueUnderHeld(Replanner& r) {
+    const size_t minPegs = size_t(r.opt.tenons.minPerPiece);
+    // The groups the plan glued where no order existed start glued: the trials plan without
+    // gluing more (planOverCandidates), so they must not need those rounds again.
+    if (r.preGlued.empty()) r.preGlued = r.out.plan.glued;
+    auto attempt = [&](const Pairs& batch, size_t before) {
+        const mount::InstallationPlan plan = r.out.plan;
+        const std::optional<size_t> after = r.tryChange(
+            [&] {
+                for (const auto& [step, neighbor] : batch)
+                    r.preGlued.push_back({plan.steps[step].pieces[0], plan.steps[neighbor].pieces[0]});
+            },
+            before, std::to_string(batch.size()) + " glued group(s)", true);
+        if (!after) return false;
+        r.out.gluedForPegs += batch.size();
+        r.context.detail(std::to_string(batch.size()) +
+                         " step(s) too few pegs would hold glued to a neighbour before mounting (" +
+                         std::to_string(before) + " -> " + std::to_string(*after) + " steps under " +
+                         std::to_string(minPegs) + " pegs)");
+        return true;
+    };
+    size_t before = 0;
+    tryPairsInRounds(
+        r, kGlueRounds, kSingleGlueTrials,
+        [&] {
+            const std::vector<size_t> pegs = stepPegs(r.out.plan, r.pegs());
+            before = underHeld(pegs, int(minPegs));
+            return before == 0 ? Pairs{} : glueUnderHeldOptions(r, pegs);
+        },
+        [&](const Pairs& pairs) { return attempt(pairs, before); });
+}
+
+}  // namespace zomefab::pieces::detail
