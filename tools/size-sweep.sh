@@ -35,11 +35,13 @@ for h in "${heights[@]}"; do
       result="$(python3 - "$dir/pieces/pieces.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
-pieces = j["pieces"]; inst = j["installation"]
+pieces = j["pieces"]; inst = j["installation"]; steps = inst["steps"]
 two = sum(1 for p in pieces if len(p["tenons"]) >= 2)
+held = sum(1 for s in steps if sum(len(pieces[p]["tenons"]) for p in s["pieces"]) >= 2)
+grouped = sum(len(s["pieces"]) for s in steps if len(s["pieces"]) > 1)
 glued = len(inst.get("glued_on", []))
-print(f"{len(pieces)} pieces, {two} with ≥ 2 tenons, {len(inst['steps'])} steps, {glued} glued on; "
-      f"{j['summary']['tenons']} tenons; verified")
+print(f"{len(pieces)} pieces, {two} with ≥ 2 tenons; {len(steps)} steps, {held} held by ≥ 2 pegs; "
+      f"{grouped} pieces in glued groups, {glued} glued on; {j['summary']['tenons']} tenons; verified")
 PY
 )"
     else

@@ -95,8 +95,10 @@ constexpr size_t kPlanesPerPair = 3;
 
 /// Rounds of glueUnderHeld (each a plan; a round glues several pairs at once).
 constexpr int kGlueRounds = 8;
-/// When a round's glues together do not help, this many are tried one by one (each a plan).
-constexpr size_t kSingleGlueTrials = 4;
+/// When a round's glues together do not help, this many are tried one by one (each a plan; at
+/// 700 mm a plan of 47 pieces takes 15–20 s, and on bunny_npm the five singles tried after its last
+/// batch all failed).
+constexpr size_t kSingleGlueTrials = 2;
 
 /// For each step under minPerPiece pegs, the neighbouring steps it could be glued to before
 /// mounting: a common cut face large enough for pins (GlueOnRule::minFaceMm2), at most
