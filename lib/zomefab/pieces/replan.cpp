@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <map>
-#include <set>
 #include <tuple>
 
 #include "zomefab/core/format.h"
@@ -58,26 +57,11 @@ namespace {
 
 using Pairs = std::vector<std::pair<uint32_t, uint32_t>>;
 
-/// Tries @p pairs together and, when that does not help, its first half and then its second, down
-/// to single pairs (one glued group that leaves another without an order can spoil a batch), while
-/// @p budget trials are left. Returns whether a trial was kept.
-bool tryHalves(const Pairs& pairs, size_t& budget, const std::function<bool(const Pairs&)>& attempt) {
-    if (pairs.empty() || budget == 0) return false;
-    --budget;
-    if (attempt(pairs)) return true;
-    if (pairs.size() == 1) return false;
-    const auto middle = pairs.begin() + std::ptrdiff_t((pairs.size() + 1) / 2);
-    return tryHalves(Pairs(pairs.begin(), middle), budget, attempt) ||
-           tryHalves(Pairs(middle, pairs.end()), budget, attempt);
-}
-
 /// The rounds mergeUnderHeld and glueUnderHeld share: each lists the pairs worth trying, best first
 /// (@p listPairs; none: done), tries those that share no member together (disjointPairs) and, when
-/// that does not help (@p attempt returns false: undone), with @p isHalving its halves (tryHalves),
-/// then the first pairs one by one, @p singles trials after the batch in all. Stops after
-/// @p rounds, or when a round keeps nothing.
-void tryPairsInRounds(Replanner& r, int rounds, size_t singles, bool isHalving,
-                      const std::function<Pairs()>& listPairs,
+/// that does not help (@p attempt returns false: undone), the first @p singles one by one. Stops
+/// after @p rounds, or when a round keeps nothing.
+void tryPairsInRounds(Replanner& r, int rounds, size_t singles, const std::function<Pairs()>& listPairs,
                       const std::function<bool(const Pairs&)>& attempt) {
     for (int round = 0; round < rounds && r.out.plan.isBuildable(); ++round) {
         r.context.throwIfCancelled();
@@ -85,23 +69,10 @@ void tryPairsInRounds(Replanner& r, int rounds, size_t singles, bool isHalving,
         const Pairs batch = disjointPairs(options);
         if (batch.empty()) return;
         if (attempt(batch)) continue;
-        size_t budget = singles;
-        std::set<std::pair<uint32_t, uint32_t>> tried;
-        if (batch.size() == 1) tried.insert(batch[0]);
         bool isKept = false;
-        if (isHalving && batch.size() > 1) {
-            const size_t middle = (batch.size() + 1) / 2;
-            isKept =
-                tryHalves(Pairs(batch.begin(), batch.begin() + std::ptrdiff_t(middle)), budget, attempt) ||
-                tryHalves(Pairs(batch.begin() + std::ptrdiff_t(middle), batch.end()), budget, attempt);
-            // Single pairs of the batch were tried as halves.
-            if (middle == 1) tried.insert(batch[0]);
-            if (batch.size() - middle == 1) tried.insert(batch.back());
-        }
-        for (size_t i = 0; i < options.size() && budget > 0 && !isKept; ++i) {
-            if (tried.count(options[i])) continue;
+        for (size_t i = 0; i < options.size() && i < singles && !isKept; ++i) {
+            if (batch.size() == 1 && batch[0] == options[i]) continue;
             r.context.throwIfCancelled();
-            --budget;
             isKept = attempt({options[i]});
         }
         if (!isKept) return;
@@ -124,13 +95,11 @@ constexpr size_t kPlanesPerPair = 3;
 
 /// Rounds of glueUnderHeld (each a plan; a round glues several pairs at once).
 constexpr int kGlueRounds = 8;
-/// When a round's glues together do not help, this many are tried one by one (each a plan): four
-/// while a plan is quick (up to kQuickPlanPieces pieces: about 2 s for the demo's 12), two beyond
-/// (at 700 mm a plan of 47 pieces takes 15–20 s, and bunny_npm's singles after its last batch all
-/// failed; the elephant's 14 pieces at 700 mm gain a step held by two pegs from its third or fourth).
+/// When a round's glues together do not help, this many are tried one by one (each a plan; at
+/// 700 mm a plan of 47 pieces takes 15–20 s). Fewer cost more than they save: with two, bunny_cgal
+/// at 700 mm kept 39 of 48 steps held by two pegs instead of 40 of 41, bunny_npm 30 of 46 instead
+/// of 31 of 33; halving a batch that does not help before the singles did no better.
 constexpr size_t kSingleGlueTrials = 4;
-constexpr size_t kSingleGlueTrialsSlow = 2;
-constexpr size_t kQuickPlanPieces = 24;
 
 /// For each step under minPerPiece pegs, the neighbouring steps it could be glued to before
 /// mounting: a common cut face large enough for pins (GlueOnRule::minFaceMm2), at most
@@ -205,7 +174,7 @@ void mergeUnderHeld(Replanner& r, const Fabrication& fabrication) {
     };
     size_t before = 0;
     tryPairsInRounds(
-        r, kMergeRounds, kSingleMergeTrials, false,
+        r, kMergeRounds, kSingleMergeTrials,
         [&] {
             const std::vector<size_t> pegs = r.pegs();
             before = underHeld(pegs, minPegs);
@@ -307,8 +276,7 @@ void glueUnderHeld(Replanner& r) {
     };
     size_t before = 0;
     tryPairsInRounds(
-        r, kGlueRounds, r.out.pieces.size() <= kQuickPlanPieces ? kSingleGlueTrials : kSingleGlueTrialsSlow,
-        true,
+        r, kGlueRounds, kSingleGlueTrials,
         [&] {
             const std::vector<size_t> pegs = stepPegs(r.out.plan, r.pegs());
             before = underHeld(pegs, int(minPegs));
