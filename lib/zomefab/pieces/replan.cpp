@@ -27,13 +27,16 @@ std::vector<size_t> stepPegs(const mount::InstallationPlan& plan, const std::vec
 }
 
 std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, size_t before,
-                                           const std::string& what, bool steps) {
+                                           const std::string& what, Change kind) {
     const Stopwatch clock;
     State kept{out.pieces, grouping.cellSets, grouping.faces, field.owner,
                out.plan,   candidates,        lost,           preGlued};
     change();
-    grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
-    candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
+    const bool steps = kind == Change::kGroups;
+    if (!steps) {  // glued groups leave the pieces, so their faces and candidates, as they are
+        grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
+        candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
+    }
     out.plan =
         planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context, preGlued);
     const size_t after = !out.plan.isBuildable() ? SIZE_MAX : steps ? underHeldStepsNow() : underHeldNow();
@@ -265,7 +268,7 @@ void glueUnderHeld(Replanner& r) {
                 for (const auto& [step, neighbor] : batch)
                     r.preGlued.push_back({plan.steps[step].pieces[0], plan.steps[neighbor].pieces[0]});
             },
-            before, std::to_string(batch.size()) + " glued group(s)", true);
+            before, std::to_string(batch.size()) + " glued group(s)", Replanner::Change::kGroups);
         if (!after) return false;
         r.out.gluedForPegs += batch.size();
         r.context.detail(std::to_string(batch.size()) +

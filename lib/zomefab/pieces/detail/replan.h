@@ -89,12 +89,16 @@ public:
     /// The steps (pieces or glued groups) under minPerPiece pegs.
     size_t underHeldStepsNow() const { return underHeld(stepPegs(out.plan, pegs()), opt.tenons.minPerPiece); }
 
-    /// Makes @p change (to the pieces, their cell sets and the voxels' owners, or preGlued),
-    /// recomputes the faces and plans again. Returns the new count of under-held pieces (@p steps:
-    /// steps) when it is below @p before with a plan that can be carried out; else undoes
-    /// everything and returns nothing.
+    /// What a change touches, and so what it is judged by.
+    enum class Change {
+        kPieces,  ///< the pieces, their cell sets and the voxels' owners: pieces under-held count
+        kGroups,  ///< preGlued only (the pieces, faces and candidates stay): steps under-held count
+    };
+    /// Makes @p change, recomputes what it touched (for kPieces the faces and the tenon candidates)
+    /// and plans again. Returns the new count of under-held pieces (kGroups: steps) when it is below
+    /// @p before with a plan that can be carried out; else undoes everything and returns nothing.
     std::optional<size_t> tryChange(const std::function<void()>& change, size_t before,
-                                    const std::string& what, bool steps = false);
+                                    const std::string& what, Change kind = Change::kPieces);
 
     Pieces& out;
     VoxelField& field;
