@@ -257,6 +257,31 @@ TEST_CASE("pieces: slivers are merged into a neighbour, never dropped") {
     CHECK(std::min(two.pieces[0].volumeMm3, two.pieces[1].volumeMm3) < 1500);
 }
 
+TEST_CASE("pieces: a speck of shell that touches nothing is dropped, not joined to a piece far away") {
+    // One inside voxel in the hollow, 60 mm from the wall: an island no piece touches (the dino
+    // at 450 mm had two; joined to the largest piece of their cell they left it no free direction).
+    openvdb::FloatGrid::Ptr grid = sdf::levelSetGrid(shell())->deepCopy();
+    const openvdb::Coord speck(int(std::lround(30.0 / kVoxel)), 0, 0);
+    REQUIRE(grid->tree().getValue(speck) > 0);
+    grid->tree().setValueOn(speck, -0.3f);
+    VoxelField field = buildField(*grid);
+    const size_t slot = field.slotAt({30.0, 0, 0});
+    REQUIRE(slot != SIZE_MAX);
+    REQUIRE(field.isInside(slot));
+    const partition::PartitionResult quadrants = quadrantCells(-5.3, 10.4);
+    const GridCells cells = toGridCells(quadrants.cells, Transform4d::identity());
+    labelCells(field, cells);
+    const Grouping withSpeck =
+        groupPieces(field, cells, quadrants.pieces, Transform4d::identity(), 10.0, 0.0, RunContext::silent());
+    CHECK_FALSE(field.isInside(slot));
+    REQUIRE(withSpeck.pieces.size() == 4);
+    CHECK(withSpeck.isolatedSlivers == 0);
+    const QuadrantPieces plain = quadrantPieces();
+    CHECK(withSpeck.shellVolumeMm3 == doctest::Approx(plain.grouping.shellVolumeMm3));
+    for (size_t p = 0; p < 4; ++p)
+        CHECK(withSpeck.pieces[p].shellVolumeMm3 == doctest::Approx(plain.grouping.pieces[p].shellVolumeMm3));
+}
+
 TEST_CASE("pieces: a cell shared by two requests and a cell no request names") {
     // Cells: 0 = x ≥ 0 and 1 = x < 0. Both requests name cell 0 (its shell part is connected, so it
     // goes whole to the request whose surface box holds most of it); no request names cell 1,

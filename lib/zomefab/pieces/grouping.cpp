@@ -16,14 +16,15 @@ namespace {
 
 using Contacts = std::map<std::pair<uint32_t, uint32_t>, size_t>;
 
-/// A piece of at most this many voxels' volume that touches no other is a speck (Merger::mergeSpeck).
-constexpr double kSpeckVoxels = 2.0;
+/// An island of the shell (inside voxels joined across cells, touching nothing else) of at most
+/// this many voxels is a speck (dropSpecks).
+constexpr size_t kSpeckVoxels = 2;
 
 /// Components of one group that touch form one piece. Then two kinds of pieces join the
 /// neighbour they share the largest cut face with: the parts of the shell in cells that no
 /// request names (cells with no outer surface: the partition meant no piece there), whatever
-/// their size, and slivers below minPieceVolumeMm3. Never dropped: with no neighbour they stay, but
-/// for specks, which join a piece of their cell (mergeSpeck).
+/// their size, and slivers below minPieceVolumeMm3. Never dropped: with no neighbour they stay
+/// (specks were dropped before, dropSpecks).
 struct Merger {
     const std::vector<Component>& comps;
     const Contacts& contacts;
@@ -97,27 +98,6 @@ struct Merger {
         return roots;
     }
 
-    /// A speck of @p root (a few voxels touching no other piece: a corner of a cell the cut grazed)
-    /// joins the largest piece that has a component in one of its cells; the mesher drops it there
-    /// (components under a voxel's volume), where kept as a piece of its own it would be an empty
-    /// mesh (seen: bunny at 600 mm, "piece 21: ... volume 0 mm³"). False when no piece shares a cell.
-    bool mergeSpeck(uint32_t root) {
-        std::vector<uint32_t> cellsOfRoot;
-        for (size_t k = 0; k < comps.size(); ++k)
-            if (sets.find(uint32_t(k)) == root) cellsOfRoot.push_back(comps[k].cell);
-        uint32_t target = kNone;
-        for (size_t k = 0; k < comps.size(); ++k) {
-            const uint32_t r = sets.find(uint32_t(k));
-            if (r == root ||
-                std::find(cellsOfRoot.begin(), cellsOfRoot.end(), comps[k].cell) == cellsOfRoot.end())
-                continue;
-            if (target == kNone || rootVolume[r] > rootVolume[target]) target = r;
-        }
-        if (target == kNone) return false;
-        join(root, target, rootSlivers[target], isOrphan[target]);
-        return true;
-    }
-
     /// Orphans first (until none can move), then slivers. Returns the orphans kept.
     size_t mergeAll(double minPieceVolumeMm3, Grouping& out, const RunContext& context) {
         size_t orphansKept = 0;
@@ -144,11 +124,6 @@ struct Merger {
             if (rootVolume[root] >= minPieceVolumeMm3) continue;
             if (mergeIntoNeighbour(root, false)) {
                 ++out.sliversMerged;
-            } else if (rootVolume[root] <= kSpeckVoxels * voxelVolume && mergeSpeck(root)) {
-                context.detail(
-                    "a " + formatNumber(rootVolume[root], 4) +
-                    " mm³ speck of the shell touches no other piece: it joins the largest piece of its cell, "
-                    "where the mesher drops it");
             } else {
                 ++out.isolatedSlivers;
                 context.warn("a " + formatNumber(rootVolume[root], 4) +
@@ -158,6 +133,27 @@ struct Merger {
         return orphansKept;
     }
 };
+
+/// Drops the specks: islands of the shell (components joined by their contacts, across cells) of
+/// at most kSpeckVoxels voxels, a corner of a cell the cut grazed or a thread of wall thinner than
+/// a voxel. Their voxels become outside voxels (φ mirrored), so no piece holds them: the mesher
+/// would drop them anyway (components under a voxel's volume), and joined to a piece they made it
+/// two islands that no plane cuts into connected halves and whose far crumb meets the frame along
+/// every direction (the dino at 450 mm: "piece 1: no direction to push it on along"). Returns how
+/// many voxels were dropped; the caller finds the components again.
+size_t dropSpecks(VoxelField& field, const std::vector<Component>& comps, const Contacts& contacts) {
+    DisjointSets islands(comps.size());
+    for (const auto& [pair, count] : contacts) islands.unite(pair.first, pair.second);
+    std::vector<size_t> islandVoxels(comps.size(), 0);
+    for (size_t k = 0; k < comps.size(); ++k) islandVoxels[islands.find(uint32_t(k))] += comps[k].voxels;
+    size_t dropped = 0;
+    for (size_t s = 0; s < field.phi.size(); ++s) {
+        if (!field.isInside(s) || islandVoxels[islands.find(field.owner[s])] > kSpeckVoxels) continue;
+        field.phi[s] = -field.phi[s];
+        ++dropped;
+    }
+    return dropped;
+}
 
 /// Piece ids: roots ordered by the lowest group they hold (then by their first voxel).
 std::vector<uint32_t> orderPieces(const std::vector<Component>& comps, DisjointSets& sets,
@@ -410,8 +406,15 @@ Grouping groupPieces(VoxelField& field, const GridCells& cells, const std::vecto
                      const RunContext& context) {
     const double voxelVolume = field.voxelMm * field.voxelMm * field.voxelMm;
     std::vector<Component> comps = findComponents(field);
+    Contacts contacts = componentContacts(field);
+    if (const size_t specks = dropSpecks(field, comps, contacts); specks > 0) {
+        context.detail(formatNumber(double(specks) * voxelVolume, 4) +
+                       " mm³ of the shell in specks of at most " + std::to_string(kSpeckVoxels) +
+                       " voxels that touch nothing else dropped (the mesher would drop them)");
+        comps = findComponents(field);
+        contacts = componentContacts(field);
+    }
     if (comps.empty()) throw Error(ErrorCode::InvalidInput, "the shell has no inside");
-    const Contacts contacts = componentContacts(field);
     context.progress("pieces", 0.15);
     context.throwIfCancelled();
     Grouping out;
