@@ -3,14 +3,17 @@
 /// one exists for some choice of directions, names the bodies that keep each other from any, and
 /// places a body no peg can hold after a piece it can be glued onto. Bodies are built by hand:
 /// slabs of voxel centres with their direction options and cut faces.
+#include "zomefab/pieces/detail/mounting.h"
+
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "zomefab/core/run_context.h"
-#include "zomefab/pieces/detail/mounting.h"
+#include "zomefab/pieces/detail/replan.h"
 #include "zomefab/zome/holes.h"
 
 using namespace zomefab;
@@ -31,10 +34,17 @@ MountBody slab(uint32_t piece, double x0, double x1, double z0, double z1) {
         for (double y = 0; y <= 10 + 1e-9; y += 1.0)
             for (double z = z0; z <= z1 + 1e-9; z += 1.0) {
                 b.voxels.push_back({x, y, z});
-                b.isNearCut.push_back(0);
+                b.nearCutOf.push_back({kNone, kNone});
                 b.bounds.expand({x, y, z});
             }
     return b;
+}
+
+/// Every voxel of @p a near its cut face with @p b and the other way round (in the planner, the
+/// voxels within two of the seam): the face, not the sweep, orders the two.
+void nearEachOther(MountBody& a, MountBody& b) {
+    for (auto [m, other] : {std::pair{&a, &b}, std::pair{&b, &a}})
+        for (auto& near : m->nearCutOf) (near[0] == kNone ? near[0] : near[1]) = other->pieces[0];
 }
 
 /// A direction the body could take: free of the frame, with @p tenons tenons.
@@ -98,7 +108,7 @@ TEST_CASE("mounting: two bodies in each other's way along every direction are st
 TEST_CASE("mounting: a cut face lets the neighbour slide along it or leave it, never go into it") {
     // A and B side by side, touching across the plane x = 10.5 (normal from A into B: +x).
     MountBody a = slab(0, 0, 10, 0, 10), b = slab(1, 11, 21, 0, 10);
-    for (MountBody* m : {&a, &b}) std::fill(m->isNearCut.begin(), m->isNearCut.end(), 1);
+    nearEachOther(a, b);
     const FaceContacts faces = {{{0, 1}, {CutContact{{1, 0, 0}, 121}}}};
     a.options = {option(kRight, 2)};  // A pushed off to the right goes into B: A first
     b.options = {option(kUp, 2)};     // B slides off along the face
@@ -114,7 +124,7 @@ TEST_CASE("mounting: a cut face lets the neighbour slide along it or leave it, n
 TEST_CASE("mounting: a body no peg can hold is glued onto a piece put on before it") {
     // C (no tenons) sits on top of A, across the plane z = 10.5; it goes on from above after A.
     MountBody a = slab(0, 0, 10, 0, 10), c = slab(1, 0, 10, 11, 15);
-    for (MountBody* m : {&a, &c}) std::fill(m->isNearCut.begin(), m->isNearCut.end(), 1);
+    nearEachOther(a, c);
     const FaceContacts faces = {{{0, 1}, {CutContact{{0, 0, 1}, 400}}}};
     a.options = {option(kRight, 2)};
     c.glueOptions = {option(kRight, 0), option(kUp, 0)};
@@ -137,7 +147,8 @@ TEST_CASE("mounting: a piece glued on goes on before its only host leaves") {
     // A holds; C sits on A, D beside C (across x = 10.5). Neither C nor D has pegs: D can only be
     // glued onto C, so C must not be taken away first, though it comes first by index.
     MountBody a = slab(0, 0, 10, 0, 10), c = slab(1, 0, 10, 11, 15), d = slab(2, 11, 21, 11, 15);
-    for (MountBody* m : {&a, &c, &d}) std::fill(m->isNearCut.begin(), m->isNearCut.end(), 1);
+    nearEachOther(a, c);
+    nearEachOther(c, d);
     const FaceContacts faces = {{{0, 1}, {CutContact{{0, 0, 1}, 400}}},
                                 {{1, 2}, {CutContact{{1, 0, 0}, 400}}}};
     a.options = {option(zome::nearestHole({-1, 0, 0}), 2)};
@@ -178,4 +189,74 @@ TEST_CASE("mounting: every pair of bodies in each other's way is glued into one 
     CHECK(std::count_if(messages.begin(), messages.end(), [](const std::string& m) {
               return m.find("2 pairs glued into one") != std::string::npos;
           }) == 1);
+}
+
+TEST_CASE("mounting: a voxel near one neighbour's seam is still swept against the other bodies") {
+    // A slides up along its seam with C (x = 10.5); C's arm reaches over A at z 20–21, under D
+    // (seam z = 21.5). The arm's voxels are near D's seam, not A's: A pushed off upward meets them,
+    // so A goes on before C. (Left out of every sweep, as once, they let A go on last.)
+    MountBody a = slab(0, 0, 10, 0, 10), c = slab(2, 11, 21, 0, 10), arm = slab(2, 0, 21, 20, 21),
+              d = slab(3, 0, 10, 22, 25);
+    // Two voxels deep on each side of a seam, as the planner marks them.
+    auto markNear = [](MountBody& m, uint32_t other, auto isNear) {
+        for (size_t i = 0; i < m.voxels.size(); ++i)
+            if (isNear(m.voxels[i])) m.nearCutOf[i][0] = other;
+    };
+    markNear(a, 2, [](const Vec3d& x) { return x[0] >= 9; });
+    markNear(c, 0, [](const Vec3d& x) { return x[0] <= 12; });
+    markNear(arm, 3, [](const Vec3d&) { return true; });  // the arm is two voxels thick
+    markNear(d, 2, [](const Vec3d& x) { return x[2] <= 23; });
+    c.voxels.insert(c.voxels.end(), arm.voxels.begin(), arm.voxels.end());
+    c.nearCutOf.insert(c.nearCutOf.end(), arm.nearCutOf.begin(), arm.nearCutOf.end());
+    c.bounds.expand(arm.bounds.min), c.bounds.expand(arm.bounds.max);
+    const FaceContacts faces = {{{0, 2}, {CutContact{{1, 0, 0}, 121}}},
+                                {{2, 3}, {CutContact{{0, 0, 1}, 121}}}};
+    a.options = {option(kUp, 2)};
+    c.options = {option(kRight, 2)};
+    d.options = {option(kUp, 2)};
+    MountBody b = slab(1, 200, 210, 0, 5);  // bodies are named by their index: piece 1 far away
+    b.options = {option(kUp, 2)};
+    const Disassembly r = disassembleAll({a, b, c, d}, faces);
+    CHECK(r.stuck.empty());
+    CHECK(std::count(r.before.begin(), r.before.end(), std::make_pair(uint32_t(0), uint32_t(2))) == 1);
+}
+
+TEST_CASE("mounting: a tenon of a piece already on that lies in a later piece's path is given up") {
+    // Piece 0 (z 0–5) holds a tenon whose stem rises from a ball at z = −40 to its wall; piece 1
+    // comes down from above after it (pushed off upward from z −60) through the stem.
+    PlannerInput input;
+    input.pieces = {slab(0, 0, 10, 0, 5), slab(1, 0, 10, -60, -55)};
+    const pieces::TenonOptions o;
+    pieces::Tenon t;
+    t.ball = 7;
+    t.hole = kUp;
+    t.piece = 0;
+    t.axisGrid = t.axisFrame = {0, 0, 1};
+    t.longSideGrid = {1, 0, 0};
+    t.ballCenterGridMm = {5, 5, -40};
+    t.shoulderMm = 10;
+    t.baseMm = 39;
+    t.endMm = 40;
+    t.pegTipMm = 6;
+    pieces::TenonPlan tenons;
+    tenons.perPiece = {{t}, {}};
+    std::vector<pieces::TenonCandidate> candidates(1);
+    candidates[0].tenon = t;
+    candidates[0].piece = 0;
+    mount::InstallationPlan plan;
+    plan.steps = {{{0}, kUp}, {{1}, kUp}};
+    std::set<std::pair<zome::BallId, int>> lost;
+    CHECK(markTenonsInPaths(plan, tenons, input, Transform4d::identity(), o, 1.0, candidates, lost) == 1);
+    CHECK(lost.count({7, kUp}) == 1);
+    CHECK(candidates[0].rejection == "in another piece's path");
+    // The other order, or piece 1 beside the stem: nothing in the way.
+    candidates[0].rejection.clear();
+    lost.clear();
+    std::swap(plan.steps[0], plan.steps[1]);
+    CHECK(markTenonsInPaths(plan, tenons, input, Transform4d::identity(), o, 1.0, candidates, lost) == 0);
+    std::swap(plan.steps[0], plan.steps[1]);
+    input.pieces[1] = slab(1, 20, 30, -60, -55);
+    CHECK(markTenonsInPaths(plan, tenons, input, Transform4d::identity(), o, 1.0, candidates, lost) == 0);
+    CHECK(candidates[0].rejection.empty());
+    CHECK(lost.empty());
 }

@@ -84,6 +84,14 @@ bool FrameSweeps::isFree(const MountBody& body, int hole, double voxelMm, std::s
     return !hit.isHit;
 }
 
+bool MountBody::isNearCutWith(size_t i, const MountBody& other) const {
+    for (uint32_t piece : nearCutOf[i])
+        if (piece != kNone &&
+            std::find(other.pieces.begin(), other.pieces.end(), piece) != other.pieces.end())
+            return true;
+    return false;
+}
+
 PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
                           const std::vector<TenonCandidate>& candidates) {
     const size_t n = out.pieces.size();
@@ -94,6 +102,17 @@ PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
     // A body pushed along d first meets things with its rearmost points, which lie on its surface:
     // the inside voxels with a 6-neighbour outside the wall or in another piece are enough.
     std::vector<uint8_t> isSurface(field.phi.size(), 0), nearCut(field.phi.size(), 0);
+    // The pieces across the cut faces each near-cut voxel is near (up to two).
+    std::vector<std::array<uint32_t, 2>> nearOf(field.phi.size(), {kNone, kNone});
+    auto addNear = [&](size_t s, uint32_t piece) {
+        auto& list = nearOf[s];
+        if (list[0] == piece || list[1] == piece) return;
+        if (list[0] == kNone)
+            list[0] = piece;
+        else if (list[1] == kNone)
+            list[1] = piece;
+        // Near a third piece's face too (a corner): swept against that one, the safe side.
+    };
     // Voxel faces per cut face (as faceContacts counts them): only faces large enough to order
     // their pieces by their plane leave their voxels out of the sweeps between neighbours.
     auto faceKey = [&](size_t a, size_t b) {
@@ -110,20 +129,30 @@ PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
         const bool isCut = ia && ib && field.owner[a] != field.owner[b];
         if (ia && (!ib || isCut)) isSurface[a] = 1;
         if (ib && (!ia || isCut)) isSurface[b] = 1;
-        if (isCut && faceSize[faceKey(a, b)] >= kMinOrderFaceVoxels) nearCut[a] = nearCut[b] = 2;
+        if (isCut && faceSize[faceKey(a, b)] >= kMinOrderFaceVoxels) {
+            nearCut[a] = nearCut[b] = 2;
+            addNear(a, field.owner[b]);
+            addNear(b, field.owner[a]);
+        }
     });
     // One more layer inward from the cut faces (6-neighbours in the same piece).
     forEachForwardPair(field, [&](size_t a, size_t b) {
         if (!field.isInside(a) || !field.isInside(b) || field.owner[a] != field.owner[b]) return;
-        if (nearCut[a] == 2 && !nearCut[b]) nearCut[b] = 1;
-        if (nearCut[b] == 2 && !nearCut[a]) nearCut[a] = 1;
+        auto spread = [&](size_t from, size_t to) {
+            if (nearCut[from] != 2 || nearCut[to] == 2) return;
+            nearCut[to] = 1;
+            for (uint32_t piece : nearOf[from])
+                if (piece != kNone) addNear(to, piece);
+        };
+        spread(a, b);
+        spread(b, a);
     });
     for (size_t s = 0; s < field.phi.size(); ++s)
         if (isSurface[s] && field.owner[s] < n) {
             const Vec3d x = field.world(field.coordOf(s));
             MountBody& body = in.pieces[field.owner[s]];
             body.voxels.push_back(x);
-            body.isNearCut.push_back(nearCut[s] ? 1 : 0);
+            body.nearCutOf.push_back(nearOf[s]);
             body.bounds.expand(x);
         }
     for (const TenonCandidate& c : candidates) {
@@ -194,7 +223,7 @@ MountBody makeBody(const std::vector<uint32_t>& members, const PlannerInput& inp
     for (uint32_t p : body.pieces) {
         const MountBody& piece = input.pieces[p];
         body.voxels.insert(body.voxels.end(), piece.voxels.begin(), piece.voxels.end());
-        body.isNearCut.insert(body.isNearCut.end(), piece.isNearCut.begin(), piece.isNearCut.end());
+        body.nearCutOf.insert(body.nearCutOf.end(), piece.nearCutOf.begin(), piece.nearCutOf.end());
         body.bounds.expand(piece.bounds.min), body.bounds.expand(piece.bounds.max);
         for (const auto& [hole, entry] : input.candidatesByHole[p]) {
             byHole[hole].first += entry.first;

@@ -15,10 +15,6 @@
 
 namespace zomefab::pieces::detail {
 
-namespace {
-
-/// Could the boxes meet when @p moving is pushed off along @p d past @p still? Their shadows on
-/// the plane normal to d overlap, and something of @p still lies ahead of @p moving's rear.
 bool shadowsMeet(const Box3d& moving, const Box3d& still, const Vec3d& d) {
     const mount::SweepAxes axes(d);
     auto range = [](const Box3d& b, const Vec3d& e) {
@@ -38,6 +34,8 @@ bool shadowsMeet(const Box3d& moving, const Box3d& still, const Vec3d& d) {
     return range(still, d).second > range(moving, d).first;
 }
 
+namespace {
+
 /// Does @p moving, pushed off along @p d, run into @p still's voxels? A voxel of tolerance: two
 /// neighbours' voxels across their cut face are a voxel apart (the face itself is tested exactly
 /// by facesAllow). Only asked where shadowsMeet (blockersOf tests that first, before its cache).
@@ -51,10 +49,10 @@ bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, 
     // Neighbours: the voxels along their cut faces are left to facesAllow (seen along a face nearly
     // parallel to d, the voxels on its two sides would seem to lie ahead of each other).
     for (size_t i = 0; i < still.voxels.size(); ++i)
-        if (!isTouching || !still.isNearCut[i])
+        if (!isTouching || !still.isNearCutWith(i, moving))
             obstacle.addPoint(still.voxels[i], 0.5 * voxelMm, uint32_t(i));
     for (size_t i = 0; i < moving.voxels.size(); ++i)
-        if (!isTouching || !moving.isNearCut[i]) body.addPoint(moving.voxels[i], 0.0, uint32_t(i));
+        if (!isTouching || !moving.isNearCutWith(i, still)) body.addPoint(moving.voxels[i], 0.0, uint32_t(i));
     return mount::worstHit(obstacle, body, voxelMm).isHit;
 }
 

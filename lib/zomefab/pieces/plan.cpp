@@ -129,6 +129,59 @@ size_t markLostTenons(const mount::InstallationPlan& plan, const TenonPlan& teno
 
 }  // namespace
 
+namespace {
+
+/// The stem of tenon @p t (its tapered prism, ball face to wall) drawn into @p r as its 12 triangles,
+/// grown by @p growMm (tenonHullMm's first 8 points: the corners at the ball's end, then at the wall).
+void drawStem(mount::DepthRaster& r, const Tenon& t, const TenonOptions& o, double growMm, uint32_t id) {
+    const std::vector<Vec3d> c = tenonHullMm(t, o);
+    // Corner k = 2·l + s (l, s: the sides); the quads of the two ends and of the four sides.
+    static constexpr int kQuads[6][4] = {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                         {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}};
+    for (const auto& q : kQuads) {
+        r.addTriangle(c[size_t(q[0])], c[size_t(q[1])], c[size_t(q[2])], growMm, id);
+        r.addTriangle(c[size_t(q[0])], c[size_t(q[2])], c[size_t(q[3])], growMm, id);
+    }
+}
+
+}  // namespace
+
+size_t markTenonsInPaths(const mount::InstallationPlan& plan, const TenonPlan& tenons,
+                         const PlannerInput& input, const Transform4d& frameToGridMm, const TenonOptions& o,
+                         double voxelMm, std::vector<TenonCandidate>& candidates,
+                         std::set<std::pair<zome::BallId, int>>& lost) {
+    std::vector<const Tenon*> before;  // the tenons of the steps already on
+    std::set<std::pair<zome::BallId, int>> found;
+    for (const mount::MountStep& step : plan.steps) {
+        if (step.hole >= 0 && !before.empty()) {
+            const Vec3d d = gridDirection(step.hole, frameToGridMm);
+            Box3d bounds;
+            for (uint32_t p : step.pieces)
+                bounds.expand(input.pieces[p].bounds.min), bounds.expand(input.pieces[p].bounds.max);
+            for (const Tenon* t : before) {
+                const Box3d stem = tenonBoundsMm(*t, o);
+                if (!shadowsMeet(bounds, stem, d)) continue;
+                Box3d both = bounds;
+                both.expand(stem.min), both.expand(stem.max);
+                const mount::SweepAxes axes(d);
+                mount::DepthRaster obstacle(axes, both, voxelMm, true, voxelMm),
+                    body(axes, both, voxelMm, false, voxelMm);
+                drawStem(obstacle, *t, o, 0.5 * voxelMm, 0);
+                for (uint32_t p : step.pieces)
+                    for (const Vec3d& x : input.pieces[p].voxels) body.addPoint(x, 0.0, p);
+                if (mount::worstHit(obstacle, body, voxelMm).isHit) found.insert({t->ball, t->hole});
+            }
+        }
+        for (uint32_t p : step.pieces)
+            for (const Tenon& t : tenons.perPiece[p]) before.push_back(&t);
+    }
+    for (TenonCandidate& c : candidates)
+        if (c.rejection.empty() && found.count({c.tenon.ball, c.tenon.hole}))
+            c.rejection = "in another piece's path";
+    lost.insert(found.begin(), found.end());
+    return found.size();
+}
+
 SplitSearch splitSearchFor(const VoxelField& field, const PiecesOptions& opt) {
     SplitSearch search;
     search.voxelMm = field.voxelMm;
@@ -167,10 +220,13 @@ mount::InstallationPlan planOverCandidates(const Pieces& out, const VoxelField& 
                          opt.tenons.maxPerPiece, context);
         if (!plan.isBuildable() || attempt == 8) return plan;
         const TenonPlan tenons = chooseTenons(candidates, plan.holeOfPiece, opt.tenons);
+        const size_t inPaths = markTenonsInPaths(plan, tenons, input, sweeps.frameToGridMm(), opt.tenons,
+                                                 field.voxelMm, candidates, lost);
         const size_t steps = markLostTenons(plan, tenons, candidates, lost);
-        if (steps == 0) return plan;
+        if (steps == 0 && inPaths == 0) return plan;
         context.debug("mounting: " + std::to_string(steps) +
-                      " steps lost their tenons to other pieces' tenons; planning again without them");
+                      " steps lost their tenons to other pieces' tenons, " + std::to_string(inPaths) +
+                      " tenons lie in later pieces' paths; planning again without them");
     }
 }
 

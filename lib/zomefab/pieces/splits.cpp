@@ -127,7 +127,7 @@ MountBody halfBody(const VoxelGraph& g, const std::vector<uint8_t>& side, uint8_
         for (uint32_t w : g.neighbours[v]) isSurface = isSurface || w == kNone || side[w] != which;
         if (!isSurface) continue;
         half.voxels.push_back((*g.voxels)[v]);
-        half.isNearCut.push_back(0);
+        half.nearCutOf.push_back({kNone, kNone});
         half.bounds.expand((*g.voxels)[v]);
     }
     half.options = rankedOptions(halfCandidates(candidates, plane, which, s), size_t(s.maxPerPiece));

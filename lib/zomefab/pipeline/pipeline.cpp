@@ -100,14 +100,23 @@ void makePieces(report::RunRecord& run, const RunOptions& options, RunContext& c
 
 /// How often the partition runs again for a piece that came out too large.
 constexpr int kMaxRefits = 3;
+/// How often the partition runs again, for smaller pieces, when its pieces have no mounting order.
+constexpr int kMaxReplans = 2;
+/// By how much each of those runs grows the fit margin (mm; each side of a region's box).
+constexpr double kReplanMarginStepMm = 3.0;
 
 /// Stages 5 and 6. A piece is its region of the surface plus the wall, the tenons and the pegs
 /// inside it; now and then (seen at 700 mm: 3.1 mm) that is larger than the region the partition
 /// fitted to the printer. The partition then runs again with its fit margin grown by the overshoot
 /// (the margin grows each side of a region's box, so half of it, plus 1 mm), so the user gets
-/// pieces instead of an error.
+/// pieces instead of an error. Pieces that can be put on in no order (two that interlock, each in
+/// the other's way along every direction that holds it, and no glue or cut the pieces stage tries
+/// frees them) are a fact of these cuts, not of the object: the partition runs again with a larger
+/// fit margin, whose smaller regions are cut elsewhere (the armadillo at 550 mm: no order at a
+/// 2 mm or 4 mm margin, 18 pieces put on at 7 mm).
 void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunContext& context) {
-    for (int refit = 0;; ++refit) {
+    int refits = 0, replans = 0;
+    for (;;) {
         partitionSurface(run, options, context);
         try {
             makePieces(run, options, context);
@@ -115,15 +124,23 @@ void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunConte
         } catch (const pieces::NotBuildable& e) {
             // A frame of a few balls in a row (no B0 cube fits) reaches little of a large surface:
             // say that this, not the plan, is why.
-            if (run.frame.lattice.cubes > 0) throw;
-            throw pieces::NotBuildable(e.message() + " (the object is thinner than one B0 cube and its " +
-                                       formatNumbers("%.0f", run.fabrication.frameDMinMm()) +
-                                       " mm clearance, so its frame is only " +
-                                       std::to_string(run.frame.structure.ballCount()) + " balls and " +
-                                       std::to_string(run.frame.structure.strutCount()) +
-                                       " struts: too few to hold every piece)");
+            if (run.frame.lattice.cubes == 0)
+                throw pieces::NotBuildable(e.message() + " (the object is thinner than one B0 cube and its " +
+                                           formatNumbers("%.0f", run.fabrication.frameDMinMm()) +
+                                           " mm clearance, so its frame is only " +
+                                           std::to_string(run.frame.structure.ballCount()) + " balls and " +
+                                           std::to_string(run.frame.structure.strutCount()) +
+                                           " struts: too few to hold every piece)");
+            if (++replans > kMaxReplans) throw;
+            const double before = run.fabrication.fitMarginMm;
+            run.fabrication.fitMarginMm = before + kReplanMarginStepMm;
+            context.info(
+                e.message() +
+                formatNumbers("; partitioning again for smaller pieces, with a fit margin of %.1f mm "
+                              "(was %.1f)",
+                              run.fabrication.fitMarginMm, before));
         } catch (const pieces::PieceTooLarge& e) {
-            if (refit == kMaxRefits) throw;
+            if (++refits > kMaxRefits) throw;
             const double before = run.fabrication.fitMarginMm;
             run.fabrication.fitMarginMm = before + 0.5 * e.overshootMm + 1.0;
             context.info(

@@ -6,6 +6,7 @@
 /// that an order exists, and the order. docs/mounting.md.
 #pragma once
 
+#include <array>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -48,9 +49,14 @@ struct DirectionOption {
 struct MountBody {
     std::vector<uint32_t> pieces;  ///< sorted; the first is the body's name
     std::vector<Vec3d> voxels;
-    /// Per voxel: within two voxels of another piece (a cut face): left out of the sweeps against
-    /// neighbours, whose order the faces decide.
-    std::vector<uint8_t> isNearCut;
+    /// Per voxel: the pieces whose cut face with this body's piece lies within two voxels (up to
+    /// two, kNone for none). Left out of the sweep against a body holding such a piece, whose order
+    /// that face decides; against every other body it is swept like any voxel (the dino at 350 mm:
+    /// a piece's rim along its cut with a third piece, left out of every sweep, hid 25.6 mm of it
+    /// in a neighbour's path).
+    std::vector<std::array<uint32_t, 2>> nearCutOf;
+    /// Whether voxel @p i lies near a cut face with one of @p other's pieces.
+    bool isNearCutWith(size_t i, const MountBody& other) const;
     Box3d bounds;
     std::vector<DirectionOption> options;
     /// For a body no peg can hold (no free direction with a tenon), or one the order leaves stuck:
@@ -119,6 +125,10 @@ MountBody makeBody(const std::vector<uint32_t>& members, const PlannerInput& inp
 
 /// Hole @p hole's direction in the grid's mm (unit).
 Vec3d gridDirection(int hole, const Transform4d& frameToGridMm);
+
+/// Could the boxes meet when @p moving is pushed off along @p d past @p still? Their shadows on
+/// the plane normal to d overlap, and something of @p still lies ahead of @p moving's rear.
+bool shadowsMeet(const Box3d& moving, const Box3d& still, const Vec3d& d);
 
 /// Fills @p body's glueOptions when no peg can hold it: every hole of @p holes, each tested for a
 /// free path (in parallel).
