@@ -74,8 +74,9 @@ int main(int argc, char** argv) {
 
     return tool.run(argc, argv, [&](json& report) {
         Fabrication fabrication = fabricationCli.resolve(tool.common().seed);
-        const pieces::PiecesOptions options =
-            piecesCli.resolve();  // bad options fail before any input is read
+        pieces::PiecesOptions options = piecesCli.resolve();  // bad options fail before any input is read
+        // No object grid here to keep new struts clear of the surface in: the frame is frame.json's.
+        options.isGrowingFrame = false;
         RunContext& context = tool.context();
         const std::vector<sdf::LevelSet> grids = sdf::parseVdb(readInputBytes(shellPath), shellPath, context);
         const sdf::LevelSet& shell = shellGrid(grids, gridName, shellPath);

@@ -877,3 +877,58 @@ TEST_CASE("pieces: a piece too few pegs hold is glued to a neighbour before moun
         CHECK(glued.pieces[p].shellVolumeMm3 == apart.pieces[p].shellVolumeMm3);
     checkClosedAndFits(glued);
 }
+
+TEST_CASE("pieces: the frame grows toward a piece too few pegs hold, inside the clearance, and holds it") {
+    // The quadrant fixture's under-held pieces; a strut may be added where its new ball stays
+    // 3 mm clear of the inner wall (the sphere is convex: the strut then does too) and collides
+    // with nothing: what the frame stage's test (frame::canGrowStrut) checks on the real object.
+    PiecesOptions o;
+    o.label.isEnabled = false;
+    o.isGluingUnderHeld = false;
+    const Vec3d centreFrameMm = affineInverse(turnedFrameToGrid()).apply({0, 0, 0});
+    const double maxCentreMm = kRadius - kShell - 8.85 - 3.0;
+    const StrutTest canGrow = [&](const zome::Structure& s, zome::BallId a, int hole, int size) {
+        if (!s.isHoleFree(a, hole)) return false;
+        const zome::GoldenVector3 end = s.ball(a).position + zome::strutVector(hole, size);
+        return s.findBall(end) == zome::kNoId &&
+               norm(sub(s.scale().toMm(end), centreFrameMm)) <= maxCentreMm && !s.ballCollides(end) &&
+               !s.strutCollides(a, hole, size);
+    };
+    auto underHeld = [&](const Pieces& r) {
+        return std::count_if(r.pieces.begin(), r.pieces.end(),
+                             [&](const Piece& p) { return p.tenons.size() < size_t(o.tenons.minPerPiece); });
+    };
+    const zome::Structure frame = makeCubeLattice(60.0);
+    auto run = [&](const PiecesOptions& options, const StrutTest& test) {
+        return makePieces(shell(), frame, turnedFrameToGrid(), quadrantCells(-15.3, 20.4),
+                          printerOf({200, 200, 200}), options, RunContext::silent(), test);
+    };
+    const Pieces plain = run(o, {});
+    const Pieces grown = run(o, canGrow);
+    MESSAGE("under two pegs: " << underHeld(plain) << " of " << plain.pieces.size() << " -> "
+                               << underHeld(grown) << ", struts grown " << grown.frameStrutsGrown);
+    REQUIRE(underHeld(plain) > 0);
+    CHECK(plain.frameStrutsGrown == 0);
+    CHECK_FALSE(plain.grownFrame.has_value());
+    REQUIRE(grown.grownFrame.has_value());
+    CHECK(grown.frameStrutsGrown > 0);
+    CHECK(underHeld(grown) < underHeld(plain));
+    CHECK(grown.plan.isBuildable());
+    const zome::Structure& bigger = *grown.grownFrame;
+    CHECK(bigger.strutCount() == frame.strutCount() + grown.frameStrutsGrown);
+    CHECK(bigger.ballCount() == frame.ballCount() + grown.frameStrutsGrown);
+    CHECK(zome::findCollisions(bigger).empty());
+    for (zome::BallId id : bigger.ballIds())
+        CHECK(norm(sub(bigger.ball(id).positionMm, centreFrameMm)) <= maxCentreMm + 1e-6);
+    // Every peg goes into a free hole of a ball of the grown frame, along its piece's direction.
+    for (const Piece& p : grown.pieces)
+        for (const Tenon& t : p.tenons) {
+            REQUIRE(bigger.hasBall(t.ball));
+            CHECK(bigger.isHoleFree(t.ball, t.hole));
+            CHECK(t.hole == p.hole);
+        }
+    checkClosedAndFits(grown);
+    // Off, the frame stays as it is even with the test.
+    o.isGrowingFrame = false;
+    CHECK(run(o, canGrow).frameStrutsGrown == 0);
+}

@@ -18,6 +18,10 @@ void RunCli::addTo(CLI::App& run) {
     frame.addTo(run);
     partition.addTo(run);
     pieces.addTo(run);
+    // zomefab run only: zf-pieces has no object grid to keep a grown frame clear of the surface in.
+    run.add_flag("!--no-frame-growth", pieces.options.isGrowingFrame,
+                 "Do not grow the frame toward a piece fewer than --min-tenons pegs hold (a strut to a new "
+                 "ball whose hole meets the piece's wall)");
     cost.addTo(run);
     preview.addTo(run);
 }

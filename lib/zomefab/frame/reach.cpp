@@ -40,6 +40,11 @@ void pushCandidates(std::priority_queue<Candidate>& queue, const zome::Structure
 
 }  // namespace
 
+bool canGrowStrut(const zome::Structure& s, const FrameField& field, zome::BallId a, int hole, int size) {
+    const auto add = detail::strutAddition(s, field, a, hole, size);
+    return add && add->existing == zome::kNoId;
+}
+
 ReachResult growForReach(zome::Structure& s, const FrameField& field, const ReachOptions& o,
                          const RunContext& context) {
     if (o.minGainSamples < 1 || !(o.sampleSpacingMm > 0) || !(o.coverage > 0 && o.coverage <= 1) ||

@@ -32,6 +32,13 @@ struct ReachResult {
     double coverageBefore = 0, coverageAfter = 0;  ///< covered fraction of the reachable samples
 };
 
+/// Whether a strut from ball @p a through @p hole, of @p size, to a new ball at its end may be added
+/// to @p structure: the hole free, no ball there yet, the ball and the strut keep the clearance
+/// (dMin) and collide with nothing. The test every growth of the frame makes (this one's, and the
+/// pieces stage's toward a piece too few pegs hold).
+bool canGrowStrut(const zome::Structure& structure, const FrameField& field, zome::BallId a, int hole,
+                  int size);
+
 /// Grows @p structure in place (docs above). Deterministic: candidates are ranked by gain, then by
 /// (ball id, hole, size). @throw Error(Usage) for bad options; Error(Cancelled).
 ReachResult growForReach(zome::Structure& structure, const FrameField& field, const ReachOptions& options,

@@ -158,11 +158,11 @@ constexpr int kFitRounds = 3;
 /// (splitOverPrinter) and everything planned again, a few rounds: a piece too large is found
 /// here, before the meshing, and not by finishPiece after it.
 void planTenonsToFit(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
-                     const FloatGrid& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
-                     const Fabrication& fabrication, const RunContext& context) {
+                     const FloatGrid& shell, zome::Structure& frame, const Transform4d& frameToGridMm,
+                     const Fabrication& fabrication, const StrutTest& canGrow, const RunContext& context) {
     for (int round = 0;; ++round) {
         planPieces(out, field, cells, grouping, shell, frame, frameToGridMm, fabrication, out.options,
-                   context);
+                   canGrow, context);
         if (round == kFitRounds) return;
         const size_t cuts =
             splitOverPrinter(out.pieces, grouping, field, cells, out.options.tenons, fabrication.pieceBoxMm(),
@@ -199,7 +199,8 @@ void requireBuildable(const Pieces& pieces) {
 
 Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
                   const Transform4d& frameToGridMm, const partition::PartitionResult& partition,
-                  const Fabrication& fabrication, const PiecesOptions& options, RunContext& context) {
+                  const Fabrication& fabrication, const PiecesOptions& options, RunContext& context,
+                  const StrutTest& canGrow) {
     Stopwatch clock;
     checkFabrication(fabrication);
     checkPiecesOptions(options);
@@ -242,7 +243,11 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
     context.progress("pieces", 0.25);
     context.throwIfCancelled();
 
-    planTenonsToFit(out, field, cells, grouping, *shell, frame, frameToGridMm, fabrication, context);
+    // The frame as the pieces stage may grow it (PiecesOptions::isGrowingFrame).
+    zome::Structure frameNow = frame;
+    planTenonsToFit(out, field, cells, grouping, *shell, frameNow, frameToGridMm, fabrication, canGrow,
+                    context);
+    if (out.frameStrutsGrown > 0) out.grownFrame = std::move(frameNow);
     // An object that cannot be built is said before the meshing, the stage's longest step.
     if (out.options.tenons.maxPerPiece > 0) requireBuildable(out);
     context.progress("pieces", 0.35);

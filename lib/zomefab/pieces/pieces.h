@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -82,7 +83,16 @@ struct PiecesOptions {
     /// go on as one body along a direction whose tenons hold both (docs/mounting.md, "Glued
     /// groups"). Nothing more to print but alignment pins; the maker glues a few pairs more.
     bool isGluingUnderHeld = true;
+    /// Grow the frame toward a piece too few pegs hold: a strut to a new ball whose hole along the
+    /// piece's direction meets its wall within a tenon's reach (docs/mounting.md, "Frame grown
+    /// toward a piece"). Only where makePieces is given a StrutTest (zomefab run).
+    bool isGrowingFrame = true;
 };
+
+/// Whether a strut from ball a through hole, of size, to a new ball at its end may be added to a
+/// frame: the frame stage's clearance from the surface and its collision tests
+/// (frame::canGrowStrut). makePieces grows the frame only with one.
+using StrutTest = std::function<bool(const zome::Structure& frame, zome::BallId a, int hole, int size)>;
 
 /// @throw Error(Usage) naming the option when a value is out of its documented range.
 void checkPiecesOptions(const PiecesOptions& options);
@@ -150,6 +160,10 @@ struct Pieces {
     size_t recutPairs = 0;
     /// Pairs glued before mounting because one of them was held by too few pegs (docs/mounting.md).
     size_t gluedForPegs = 0;
+    /// The frame with the struts grown toward pieces too few pegs hold (PiecesOptions::
+    /// isGrowingFrame): the frame to build and to write. Empty when none was grown.
+    std::optional<zome::Structure> grownFrame;
+    size_t frameStrutsGrown = 0;
     Transform4d frameToGridMm;
     Transform4d gridTransformMm;  ///< the shell's LevelSetInfo::transformMm (input mesh → grid mm)
     PiecesOptions options;
@@ -193,8 +207,10 @@ void requireBuildable(const Pieces& pieces);
 ///        printer in no orientation (the partition must cut smaller); Error(ProcessingFailed)
 ///        when a piece mesh is not closed, or (tenons on) when the installation plan has
 ///        problems (requireBuildable, before any piece is meshed); Error(Cancelled).
+/// @param canGrow       when given (and options.isGrowingFrame), the frame may grow toward pieces
+///                      too few pegs hold; the result's grownFrame is then the frame to build
 Pieces makePieces(const sdf::LevelSet& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
                   const partition::PartitionResult& partition, const Fabrication& fabrication,
-                  const PiecesOptions& options, RunContext& context);
+                  const PiecesOptions& options, RunContext& context, const StrutTest& canGrow = {});
 
 }  // namespace zomefab::pieces

@@ -94,6 +94,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                     {"seam_gap_mm", o.seamGapMm},
                     {"recut_pairs", o.isRecuttingPairs},
                     {"glue_under_held", o.isGluingUnderHeld},
+                    {"grow_frame", o.isGrowingFrame},
                     {"pins",
                      {{"diameter_mm", o.pins.diameterMm},
                       {"length_mm", o.pins.lengthMm},
@@ -193,6 +194,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                     {"merged_pieces", all.mergedPieces},
                     {"recut_pairs", all.recutPairs},
                     {"glued_for_pegs", all.gluedForPegs},
+                    {"frame_struts_grown", all.frameStrutsGrown},
                     {"tenons", tenonCount},
                     {"pieces_with_few_tenons", fewTenons},
                     {"labelled", labelled}};

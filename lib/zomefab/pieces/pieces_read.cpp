@@ -272,6 +272,7 @@ Pieces piecesFromJson(const json& j, const std::string& directory) {
     out.mergedPieces = countFromJson(summary, "merged_pieces", 0);
     out.recutPairs = countFromJson(summary, "recut_pairs", 0);
     out.gluedForPegs = countFromJson(summary, "glued_for_pegs", 0);
+    out.frameStrutsGrown = countFromJson(summary, "frame_struts_grown", 0);
     return out;
 }
 

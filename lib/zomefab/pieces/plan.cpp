@@ -253,11 +253,16 @@ namespace {
 /// The installation plan, re-cutting blocked pieces and planning again (a few rounds), and the
 /// tenons along each piece's direction.
 void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
-                           const ShellProbe& probe, const zome::Structure& frame,
-                           const Transform4d& frameToGridMm, const Fabrication& fabrication,
-                           const PiecesOptions& opt, const RunContext& context) {
-    const FrameSweeps sweeps(frame, frameToGridMm, planBounds(field, frame, frameToGridMm), field.voxelMm,
-                             opt.mount.frameMarginMm);
+                           const ShellProbe& probe, zome::Structure& frame, const Transform4d& frameToGridMm,
+                           const Fabrication& fabrication, const PiecesOptions& opt, const StrutTest& canGrow,
+                           const RunContext& context) {
+    std::optional<FrameSweeps> sweepsNow;  // made again when the frame grows
+    auto remakeSweeps = [&] {
+        sweepsNow.emplace(frame, frameToGridMm, planBounds(field, frame, frameToGridMm), field.voxelMm,
+                          opt.mount.frameMarginMm);
+    };
+    remakeSweeps();
+    const FrameSweeps& sweeps = *sweepsNow;
     std::vector<TenonCandidate> candidates;
     std::set<std::pair<zome::BallId, int>> lost;  // candidates other pieces' tenons took
     size_t lastUnplaced = SIZE_MAX;
@@ -288,8 +293,23 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
                       " s");
         if (cut == 0) break;
     }
-    Replanner replanner(out, field, cells, grouping, probe, frame, frameToGridMm, sweeps, candidates, lost,
-                        opt, context);
+    if (opt.isGrowingFrame && canGrow && opt.tenons.minPerPiece > 0) {
+        GrowthInput growth{out,
+                           field,
+                           grouping.faces,
+                           probe,
+                           frame,
+                           frameToGridMm,
+                           candidates,
+                           lost,
+                           opt,
+                           context,
+                           [&]() -> const FrameSweeps& { return *sweepsNow; },
+                           remakeSweeps};
+        out.frameStrutsGrown += growFrameForPieces(growth, canGrow);
+    }
+    Replanner replanner(out, field, cells, grouping, probe, frame, frameToGridMm, *sweepsNow, candidates,
+                        lost, opt, context);
     mergeUnderHeld(replanner, fabrication);
     if (opt.isRecuttingPairs) recutUnderHeldPairs(replanner, fabrication);
     // Last: glued groups are pairs of piece numbers, which merges and cuts would change.
@@ -313,8 +333,9 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
 }  // namespace
 
 void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
-                const FloatGrid& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
-                const Fabrication& fabrication, const PiecesOptions& opt, const RunContext& context) {
+                const FloatGrid& shell, zome::Structure& frame, const Transform4d& frameToGridMm,
+                const Fabrication& fabrication, const PiecesOptions& opt, const StrutTest& canGrow,
+                const RunContext& context) {
     const FloatGrid::ConstAccessor probeAccessor = shell.getConstAccessor();
     const openvdb::tools::GridSampler<FloatGrid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
         probeAccessor, shell.transform());
@@ -333,7 +354,7 @@ void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping
     };
     if (opt.tenons.maxPerPiece > 0) {
         planMountingAndTenons(out, field, cells, grouping, probe, frame, frameToGridMm, fabrication, opt,
-                              context);
+                              canGrow, context);
     } else {
         out.plan = {};
         out.plan.holeOfPiece.assign(out.pieces.size(), -1);

@@ -161,6 +161,12 @@ TenonCandidate candidateAlong(const zome::Structure& frame, zome::BallId id, int
 
 }  // namespace
 
+TenonCandidate tenonCandidate(const zome::Structure& frame, zome::BallId id, int hole,
+                              const Transform4d& frameToGridMm, const ShellProbe& probe,
+                              const TenonOptions& o) {
+    return candidateAlong(frame, id, hole, frameToGridMm, probe, o);
+}
+
 const char* tenonHolesName(TenonHoles holes) {
     switch (holes) {
         case TenonHoles::Lattice:

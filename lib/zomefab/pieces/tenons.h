@@ -141,6 +141,12 @@ struct TenonCandidate {
     double score = 0.0;     ///< larger is better: perpendicular and short
 };
 
+/// The ray of ball @p id along @p hole: where it meets the wall, which piece, and why it cannot be a
+/// tenon (empty rejection: it can).
+TenonCandidate tenonCandidate(const zome::Structure& frame, zome::BallId id, int hole,
+                              const Transform4d& frameToGridMm, const ShellProbe& probe,
+                              const TenonOptions& options);
+
 /// The rays of every ball along every hole of options.holes, in (ball id, hole) order.
 std::vector<TenonCandidate> findTenonCandidates(const zome::Structure& frame,
                                                 const Transform4d& frameToGridMm, const ShellProbe& probe,

@@ -5,6 +5,7 @@
 #include "zomefab/core/format.h"
 #include "zomefab/core/version.h"
 #include "zomefab/frame/outermost.h"
+#include "zomefab/frame/reach.h"
 #include "zomefab/pieces/pieces.h"
 #include "zomefab/report/run_report.h"
 #include "zomefab/sdf/interior_field.h"
@@ -60,9 +61,10 @@ void levelSets(report::RunRecord& run, const RunOptions& options, RunContext& co
     });
 }
 
-/// Stage 4: the frame (paper §4), in the frame's millimetres (the lattice may be rotated).
-void buildFrame(report::RunRecord& run, const RunOptions& options, RunContext& context) {
-    const sdf::InteriorField interior = sdf::makeInteriorField(run.field.interior, context);
+/// Stage 4: the frame (paper §4), in the frame's millimetres (the lattice may be rotated). Returns
+/// the interior field, which the pieces stage grows the frame in.
+sdf::InteriorField buildFrame(report::RunRecord& run, const RunOptions& options, RunContext& context) {
+    sdf::InteriorField interior = sdf::makeInteriorField(run.field.interior, context);
     run.frame = timedStage("frame", run, context, [&] {
         return aboutInput(run.sourceName, [&] {
             return frame::buildFrame(interior, run.fabrication, options.frame, context);
@@ -72,6 +74,7 @@ void buildFrame(report::RunRecord& run, const RunOptions& options, RunContext& c
     const frame::FrameField field(interior, run.frame.rotationDeg, run.frame.structure.scale(),
                                   run.frame.zone);
     run.frameMetrics = frame::measureFrame(run.frame.structure, field, options.frame.surfaceSampleSpacingMm);
+    return interior;
 }
 
 /// Stage 5: the surface partition (paper §5) of the outer surface, in frame coordinates.
@@ -87,14 +90,28 @@ void partitionSurface(report::RunRecord& run, const RunOptions& options, RunCont
     });
 }
 
-/// Stage 6: printable pieces (paper §6): the shell cut by the partition's cells, with tenons.
-void makePieces(report::RunRecord& run, const RunOptions& options, RunContext& context) {
+/// Stage 6: printable pieces (paper §6): the shell cut by the partition's cells, with tenons. The
+/// frame may grow toward pieces too few pegs hold (in @p interior, with the frame stage's clearance
+/// and collision tests); the grown frame is the one built and written.
+void makePieces(report::RunRecord& run, const RunOptions& options, RunContext& context,
+                const sdf::InteriorField& interior) {
+    const frame::FrameField field(interior, run.frame.rotationDeg, run.frame.structure.scale(),
+                                  run.frame.zone);
+    const pieces::StrutTest canGrow = [&](const zome::Structure& s, zome::BallId a, int hole, int size) {
+        return frame::canGrowStrut(s, field, a, hole, size);
+    };
     run.pieces = timedStage("pieces", run, context, [&] {
         const Transform4d frameToGridMm = run.shell.info().transformMm * affineInverse(run.frameTransformMm);
         return pieces::makePieces(run.shell, run.frame.structure, frameToGridMm, run.partition,
-                                  run.fabrication, options.pieces, context);
+                                  run.fabrication, options.pieces, context, canGrow);
     });
     pieces::requireBuildable(run.pieces);  // exit 3 with the plan's reasons; nothing is written
+    if (run.pieces.grownFrame) {
+        run.frame.structure = std::move(*run.pieces.grownFrame);
+        run.pieces.grownFrame.reset();
+        run.frameMetrics =
+            frame::measureFrame(run.frame.structure, field, options.frame.surfaceSampleSpacingMm);
+    }
     run.plates = pieces::packPlates(run.pieces);
 }
 
@@ -114,12 +131,13 @@ constexpr double kReplanMarginStepMm = 3.0;
 /// frees them) are a fact of these cuts, not of the object: the partition runs again with a larger
 /// fit margin, whose smaller regions are cut elsewhere (the armadillo at 550 mm: no order at a
 /// 2 mm or 4 mm margin, 18 pieces put on at 7 mm).
-void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunContext& context) {
+void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunContext& context,
+                     const sdf::InteriorField& interior) {
     int refits = 0, replans = 0;
     for (;;) {
         partitionSurface(run, options, context);
         try {
-            makePieces(run, options, context);
+            makePieces(run, options, context, interior);
             return;
         } catch (const pieces::NotBuildable& e) {
             // A frame of a few balls in a row (no B0 cube fits) reaches little of a large surface:
@@ -196,8 +214,8 @@ report::RunRecord runPipeline(const TriMesh& input, const std::string& sourceNam
         return mesh::scaleToMillimetres(std::move(valid), options.scale);
     });
     levelSets(run, options, context);
-    buildFrame(run, options, context);
-    partitionAndCut(run, options, context);
+    const sdf::InteriorField interior = buildFrame(run, options, context);
+    partitionAndCut(run, options, context, interior);
     reportRun(run, options, context);
     run.totalSeconds = total.seconds();
     return run;

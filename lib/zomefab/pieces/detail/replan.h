@@ -54,6 +54,30 @@ size_t markTenonsInPaths(const mount::InstallationPlan& plan, const TenonPlan& t
                          double voxelMm, std::vector<TenonCandidate>& candidates,
                          std::set<std::pair<zome::BallId, int>>& lost);
 
+/// What growFrameForPieces works on: the planning state of the pieces stage (pieces/plan.cpp).
+struct GrowthInput {
+    Pieces& out;
+    const VoxelField& field;
+    const FaceContacts& faces;
+    const ShellProbe& probe;
+    zome::Structure& frame;  ///< grown in place
+    const Transform4d& frameToGridMm;
+    std::vector<TenonCandidate>& candidates;
+    std::set<std::pair<zome::BallId, int>>& lost;
+    const PiecesOptions& opt;
+    const RunContext& context;
+    std::function<const FrameSweeps&()> sweeps;  ///< the frame's sweeps as they are now
+    std::function<void()> remakeSweeps;          ///< after the frame changed
+};
+
+/// Grows the frame toward the pieces fewer than minPerPiece pegs hold along their planned direction
+/// (docs/mounting.md, "Frame grown toward a piece"): for each, the strut (from any ball, any hole and
+/// size that @p canGrow allows: clearance, collisions) to a new ball whose hole along the piece's
+/// direction is the piece's best tenon candidate, one per missing peg; all at once, then the
+/// candidates and the plan made again, kept only when fewer pieces are under-held with a plan that
+/// can be carried out (else undone). A few rounds. Returns how many struts were added.
+size_t growFrameForPieces(GrowthInput& in, const StrutTest& canGrow);
+
 /// The tenon candidates of the pieces as they are now, those other pieces' tenons took (@p lost)
 /// rejected.
 std::vector<TenonCandidate> freshCandidates(const zome::Structure& frame, const Transform4d& frameToGridMm,

@@ -23,10 +23,12 @@ namespace zomefab::pieces::detail {
 /// faces; pieces too few pegs hold merged with a neighbour, which renumbers them), then the tenons
 /// (paper §6.1) along each piece's direction and the engraved numbers, against the shell @p shell.
 /// @p fabrication: the wall (a stem's end stays in it) and the printer (what a merged piece must
-/// fit). Warnings for pieces short of tenons or numbers.
+/// fit). With @p canGrow, @p frame may grow toward pieces too few pegs hold (growFrameForPieces).
+/// Warnings for pieces short of tenons or numbers.
 void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
-                const FloatGrid& shell, const zome::Structure& frame, const Transform4d& frameToGridMm,
-                const Fabrication& fabrication, const PiecesOptions& options, const RunContext& context);
+                const FloatGrid& shell, zome::Structure& frame, const Transform4d& frameToGridMm,
+                const Fabrication& fabrication, const PiecesOptions& options, const StrutTest& canGrow,
+                const RunContext& context);
 
 /// For every piece, the leaves that hold its inside voxels and their 26 neighbours (the band is
 /// three voxels wide).
