@@ -29,6 +29,12 @@ struct Growth {
     double score = -1e300;
 };
 
+/// Adds @p g's strut, with the new ball at its end, to @p frame.
+void addGrowth(zome::Structure& frame, const Growth& g) {
+    frame.addBall(frame.ball(g.a).position + zome::strutVector(g.hole, g.size));
+    frame.addStrut(g.a, g.hole, g.size);
+}
+
 /// Does the ray from @p origin along @p dir (unit) meet @p box within @p reach (mm)? Slabs.
 bool rayMeetsBox(const Vec3d& origin, const Vec3d& dir, const Box3d& box, double reach) {
     double t0 = 0.0, t1 = reach;
@@ -92,15 +98,14 @@ std::optional<Growth> bestGrowth(zome::Structure& frame, uint32_t p, int hole, c
 /// The struts that give piece @p p up to @p need more tenon candidates along @p hole, found one after
 /// another on a copy of @p frame (each new ball in the next one's frame); fewer when no more is found.
 std::vector<Growth> growthsAlong(const zome::Structure& frame, uint32_t p, int hole, size_t need,
-                                 const Box3d& box, const GrowthInput& in, const StrutTest& canGrow) {
+                                 const Box3d& box, const Replanner& r, const StrutTest& canGrow) {
     zome::Structure trial = frame;
     std::vector<Growth> list;
     for (size_t k = 0; k < need; ++k) {
         const std::optional<Growth> g =
-            bestGrowth(trial, p, hole, box, in.frameToGridMm, in.probe, in.opt.tenons, canGrow);
+            bestGrowth(trial, p, hole, box, r.frameToGridMm, r.probe, r.opt.tenons, canGrow);
         if (!g) break;
-        trial.addBall(trial.ball(g->a).position + zome::strutVector(g->hole, g->size));
-        trial.addStrut(g->a, g->hole, g->size);
+        addGrowth(trial, *g);
         list.push_back(*g);
     }
     return list;
@@ -111,18 +116,18 @@ std::vector<Growth> growthsAlong(const zome::Structure& frame, uint32_t p, int h
 /// that gives it minPegs candidates along another direction its path is free along (the first in
 /// hole order; the plan made again may then choose that direction). Empty when nothing helps.
 std::vector<Growth> growthsFor(const zome::Structure& frame, uint32_t p, size_t pegs, const Box3d& box,
-                               const PlannerInput& input, const GrowthInput& in, const StrutTest& canGrow) {
-    const size_t minPegs = size_t(in.opt.tenons.minPerPiece);
-    const int hole = in.out.plan.holeOfPiece[p];
-    std::vector<Growth> along = growthsAlong(frame, p, hole, minPegs - pegs, box, in, canGrow);
+                               const PlannerInput& input, const Replanner& r, const StrutTest& canGrow) {
+    const size_t minPegs = size_t(r.opt.tenons.minPerPiece);
+    const int hole = r.out.plan.holeOfPiece[p];
+    std::vector<Growth> along = growthsAlong(frame, p, hole, minPegs - pegs, box, r, canGrow);
     if (!along.empty()) return along;
     // Other directions: only those the piece already has a candidate along and lacks one more for
     // (one strut each; trying every free direction for every missing peg tripled the dino's 700 mm run).
     for (const auto& [other, entry] : input.candidatesByHole[p]) {
         if (other == hole || entry.first + 1 != minPegs ||
-            !in.sweeps().isFree(input.pieces[p], other, in.field.voxelMm, nullptr))
+            !r.sweeps.isFree(input.pieces[p], other, r.field.voxelMm, nullptr))
             continue;
-        std::vector<Growth> list = growthsAlong(frame, p, other, 1, box, in, canGrow);
+        std::vector<Growth> list = growthsAlong(frame, p, other, 1, box, r, canGrow);
         if (!list.empty()) return list;
     }
     return {};
@@ -130,63 +135,39 @@ std::vector<Growth> growthsFor(const zome::Structure& frame, uint32_t p, size_t 
 
 }  // namespace
 
-size_t growFrameForPieces(GrowthInput& in, const StrutTest& canGrow) {
+size_t growFrameForPieces(Replanner& r, const StrutTest& canGrow) {
     if (!canGrow) return 0;
-    const Pieces& out = in.out;
-    const size_t minPegs = size_t(in.opt.tenons.minPerPiece);
+    const size_t minPegs = size_t(r.opt.tenons.minPerPiece);
     size_t grown = 0;
-    for (int round = 0; round < kGrowRounds && out.plan.isBuildable(); ++round) {
-        in.context.throwIfCancelled();
-        const std::vector<size_t> pegs = pegCounts(in.candidates, out.plan, in.opt.tenons);
-        const size_t before = underHeld(pegs, in.opt.tenons.minPerPiece);
+    for (int round = 0; round < kGrowRounds && r.out.plan.isBuildable(); ++round) {
+        r.context.throwIfCancelled();
+        const std::vector<size_t> pegs = r.pegs();
+        const size_t before = underHeld(pegs, r.opt.tenons.minPerPiece);
         if (before == 0) break;
-        const std::vector<Box3d> boxes = pieceBoxes(in.field, out.pieces.size());
-        const PlannerInput input = plannerInput(out, in.field, in.candidates);
-        zome::Structure trial = in.frame;
+        const std::vector<Box3d> boxes = pieceBoxes(r.field, r.out.pieces.size());
+        const PlannerInput input = plannerInput(r.out, r.field, r.candidates);
+        zome::Structure trial = r.frame;
         size_t added = 0;
-        for (uint32_t p = 0; p < out.pieces.size(); ++p) {
-            if (pegs[p] >= minPegs || out.plan.holeOfPiece[p] < 0 || boxes[p].isEmpty()) continue;
-            for (const Growth& g : growthsFor(trial, p, pegs[p], boxes[p], input, in, canGrow)) {
+        for (uint32_t p = 0; p < r.out.pieces.size(); ++p) {
+            if (pegs[p] >= minPegs || r.out.plan.holeOfPiece[p] < 0 || boxes[p].isEmpty()) continue;
+            for (const Growth& g : growthsFor(trial, p, pegs[p], boxes[p], input, r, canGrow)) {
                 // A strut found for an earlier piece this round may have taken the hole or the spot.
                 if (!canGrow(trial, g.a, g.hole, g.size)) continue;
-                trial.addBall(trial.ball(g.a).position + zome::strutVector(g.hole, g.size));
-                trial.addStrut(g.a, g.hole, g.size);
+                addGrowth(trial, g);
                 ++added;
             }
         }
-        in.context.debug("mounting: growing the frame: " + std::to_string(added) + " strut(s) found for " +
-                         std::to_string(before) + " piece(s) under " + std::to_string(minPegs) + " pegs");
+        r.context.debug("mounting: growing the frame: " + std::to_string(added) + " strut(s) found for " +
+                        std::to_string(before) + " piece(s) under " + std::to_string(minPegs) + " pegs");
         if (added == 0) break;
-        const zome::Structure kept = in.frame;
-        const mount::InstallationPlan keptPlan = out.plan;
-        const std::vector<TenonCandidate> keptCandidates = in.candidates;
-        const auto keptLost = in.lost;
-        in.frame = std::move(trial);
-        in.remakeSweeps();
-        in.candidates = freshCandidates(in.frame, in.frameToGridMm, in.probe, in.opt, in.lost);
-        in.out.plan = planOverCandidates(in.out, in.field, in.faces, in.sweeps(), in.candidates, in.lost,
-                                         in.opt, in.context);
-        const size_t after =
-            in.out.plan.isBuildable()
-                ? underHeld(pegCounts(in.candidates, in.out.plan, in.opt.tenons), int(minPegs))
-                : SIZE_MAX;
-        in.context.debug("mounting: frame grown by " + std::to_string(added) + " struts: pieces under " +
-                         std::to_string(minPegs) + " pegs " + std::to_string(before) + " -> " +
-                         (after == SIZE_MAX ? std::string("no plan") : std::to_string(after)));
-        if (after < before) {
-            grown += added;
-            continue;
-        }
-        in.frame = kept;
-        in.remakeSweeps();
-        in.out.plan = keptPlan;
-        in.candidates = keptCandidates;
-        in.lost = keptLost;
-        break;
+        if (!r.tryChange([&] { r.frame = std::move(trial); }, before,
+                         "frame grown by " + std::to_string(added) + " struts", Replanner::Change::kFrame))
+            break;
+        grown += added;
     }
     if (grown > 0)
-        in.context.detail("the frame grew by " + std::to_string(grown) +
-                          " strut(s), each to a new ball, toward pieces too few pegs held");
+        r.context.detail("the frame grew by " + std::to_string(grown) +
+                         " strut(s), each to a new ball, toward pieces too few pegs held");
     return grown;
 }
 

@@ -293,23 +293,10 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
                       " s");
         if (cut == 0) break;
     }
-    if (opt.isGrowingFrame && canGrow && opt.tenons.minPerPiece > 0) {
-        GrowthInput growth{out,
-                           field,
-                           grouping.faces,
-                           probe,
-                           frame,
-                           frameToGridMm,
-                           candidates,
-                           lost,
-                           opt,
-                           context,
-                           [&]() -> const FrameSweeps& { return *sweepsNow; },
-                           remakeSweeps};
-        out.frameStrutsGrown += growFrameForPieces(growth, canGrow);
-    }
-    Replanner replanner(out, field, cells, grouping, probe, frame, frameToGridMm, *sweepsNow, candidates,
-                        lost, opt, context);
+    Replanner replanner(out, field, cells, grouping, probe, frame, frameToGridMm, sweeps, remakeSweeps,
+                        candidates, lost, opt, context);
+    if (opt.isGrowingFrame && canGrow && opt.tenons.minPerPiece > 0)
+        out.frameStrutsGrown += growFrameForPieces(replanner, canGrow);
     mergeUnderHeld(replanner, fabrication);
     if (opt.isRecuttingPairs) recutUnderHeldPairs(replanner, fabrication);
     // Last: glued groups are pairs of piece numbers, which merges and cuts would change.

@@ -29,14 +29,17 @@ std::vector<size_t> stepPegs(const mount::InstallationPlan& plan, const std::vec
 std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, size_t before,
                                            const std::string& what, Change kind) {
     const Stopwatch clock;
-    State kept{out.pieces, grouping.cellSets, grouping.faces, field.owner,
-               out.plan,   candidates,        lost,           preGlued};
+    State kept{out.pieces, grouping.cellSets, grouping.faces, field.owner, out.plan, candidates,
+               lost,       preGlued,          std::nullopt};
+    if (kind == Change::kFrame) kept.frame = frame;
     change();
     const bool steps = kind == Change::kGroups;
-    if (!steps) {  // glued groups leave the pieces, so their faces and candidates, as they are
+    if (kind == Change::kPieces)
         grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
+    else if (kind == Change::kFrame)
+        remakeSweeps();
+    if (!steps)  // glued groups leave the pieces and the frame, so the candidates, as they are
         candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
-    }
     out.plan =
         planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context, preGlued);
     const size_t after = !out.plan.isBuildable() ? SIZE_MAX : steps ? underHeldStepsNow() : underHeldNow();
@@ -53,6 +56,10 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
     candidates = std::move(kept.candidates);
     lost = std::move(kept.lost);
     preGlued = std::move(kept.preGlued);
+    if (kept.frame) {
+        frame = std::move(*kept.frame);
+        remakeSweeps();
+    }
     return std::nullopt;
 }
 

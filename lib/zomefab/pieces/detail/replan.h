@@ -54,30 +54,6 @@ size_t markTenonsInPaths(const mount::InstallationPlan& plan, const TenonPlan& t
                          double voxelMm, std::vector<TenonCandidate>& candidates,
                          std::set<std::pair<zome::BallId, int>>& lost);
 
-/// What growFrameForPieces works on: the planning state of the pieces stage (pieces/plan.cpp).
-struct GrowthInput {
-    Pieces& out;
-    const VoxelField& field;
-    const FaceContacts& faces;
-    const ShellProbe& probe;
-    zome::Structure& frame;  ///< grown in place
-    const Transform4d& frameToGridMm;
-    std::vector<TenonCandidate>& candidates;
-    std::set<std::pair<zome::BallId, int>>& lost;
-    const PiecesOptions& opt;
-    const RunContext& context;
-    std::function<const FrameSweeps&()> sweeps;  ///< the frame's sweeps as they are now
-    std::function<void()> remakeSweeps;          ///< after the frame changed
-};
-
-/// Grows the frame toward the pieces fewer than minPerPiece pegs hold along their planned direction
-/// (docs/mounting.md, "Frame grown toward a piece"): for each, the strut (from any ball, any hole and
-/// size that @p canGrow allows: clearance, collisions) to a new ball whose hole along the piece's
-/// direction is the piece's best tenon candidate, one per missing peg; all at once, then the
-/// candidates and the plan made again, kept only when fewer pieces are under-held with a plan that
-/// can be carried out (else undone). A few rounds. Returns how many struts were added.
-size_t growFrameForPieces(GrowthInput& in, const StrutTest& canGrow);
-
 /// The tenon candidates of the pieces as they are now, those other pieces' tenons took (@p lost)
 /// rejected.
 std::vector<TenonCandidate> freshCandidates(const zome::Structure& frame, const Transform4d& frameToGridMm,
@@ -100,10 +76,10 @@ std::vector<size_t> stepPegs(const mount::InstallationPlan& plan, const std::vec
 class Replanner {
 public:
     Replanner(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
-              const ShellProbe& probe, const zome::Structure& frame, const Transform4d& frameToGridMm,
-              const FrameSweeps& sweeps, std::vector<TenonCandidate>& candidates,
-              std::set<std::pair<zome::BallId, int>>& lost, const PiecesOptions& opt,
-              const RunContext& context)
+              const ShellProbe& probe, zome::Structure& frame, const Transform4d& frameToGridMm,
+              const FrameSweeps& sweeps, std::function<void()> remakeSweeps,
+              std::vector<TenonCandidate>& candidates, std::set<std::pair<zome::BallId, int>>& lost,
+              const PiecesOptions& opt, const RunContext& context)
         : out(out),
           field(field),
           cells(cells),
@@ -112,6 +88,7 @@ public:
           frame(frame),
           frameToGridMm(frameToGridMm),
           sweeps(sweeps),
+          remakeSweeps(std::move(remakeSweeps)),
           candidates(candidates),
           lost(lost),
           opt(opt),
@@ -127,9 +104,11 @@ public:
     enum class Change {
         kPieces,  ///< the pieces, their cell sets and the voxels' owners: pieces under-held count
         kGroups,  ///< preGlued only (the pieces, faces and candidates stay): steps under-held count
+        kFrame,   ///< the frame (grown): its sweeps and the tenon candidates; pieces under-held count
     };
-    /// Makes @p change, recomputes what it touched (for kPieces the faces and the tenon candidates)
-    /// and plans again. Returns the new count of under-held pieces (kGroups: steps) when it is below
+    /// Makes @p change, recomputes what it touched (for kPieces the faces and the tenon candidates,
+    /// for kFrame the sweeps and the candidates) and plans again. Returns the new count of under-held pieces
+    /// (kGroups: steps) when it is below
     /// @p before with a plan that can be carried out; else undoes everything and returns nothing.
     std::optional<size_t> tryChange(const std::function<void()>& change, size_t before,
                                     const std::string& what, Change kind = Change::kPieces);
@@ -139,9 +118,10 @@ public:
     const GridCells& cells;
     Grouping& grouping;
     const ShellProbe& probe;
-    const zome::Structure& frame;
+    zome::Structure& frame;  ///< changed only by kFrame changes (growFrameForPieces)
     const Transform4d& frameToGridMm;
-    const FrameSweeps& sweeps;
+    const FrameSweeps& sweeps;  ///< of the frame as it is: made again by remakeSweeps
+    std::function<void()> remakeSweeps;
     std::vector<TenonCandidate>& candidates;
     std::set<std::pair<zome::BallId, int>>& lost;
     const PiecesOptions& opt;
@@ -160,8 +140,17 @@ private:
         std::vector<TenonCandidate> candidates;
         std::set<std::pair<zome::BallId, int>> lost;
         std::vector<std::pair<uint32_t, uint32_t>> preGlued;
+        std::optional<zome::Structure> frame;  ///< kFrame changes only
     };
 };
+
+/// Grows the frame toward the pieces fewer than minPerPiece pegs hold along their planned direction
+/// (docs/mounting.md, "Frame grown toward a piece"): for each, the strut (from any ball, any hole and
+/// size that @p canGrow allows: clearance, collisions) to a new ball whose hole along the piece's
+/// direction is the piece's best tenon candidate, one per missing peg; all at once, as one kFrame
+/// change (kept only when fewer pieces are under-held with a plan that can be carried out). A few
+/// rounds. Returns how many struts were added.
+size_t growFrameForPieces(Replanner& r, const StrutTest& canGrow);
 
 /// Pieces fewer than minPerPiece pegs hold are printed as one with a neighbour (detail/merges.h) and
 /// the plan made again, while that leaves fewer such pieces and a plan that can be carried out. Each
