@@ -121,6 +121,8 @@ constexpr int kMaxRefits = 3;
 constexpr int kMaxReplans = 2;
 /// By how much each of those runs grows the fit margin (mm; each side of a region's box).
 constexpr double kReplanMarginStepMm = 3.0;
+/// The largest tenon tilt of those runs (degrees; pieces::TenonOptions::maxTiltDeg, default 60).
+constexpr double kReplanTiltDeg = 35.0;
 
 /// Stages 5 and 6. A piece is its region of the surface plus the wall, the tenons and the pegs
 /// inside it; now and then (seen at 700 mm: 3.1 mm) that is larger than the region the partition
@@ -130,14 +132,18 @@ constexpr double kReplanMarginStepMm = 3.0;
 /// the other's way along every direction that holds it, and no glue or cut the pieces stage tries
 /// frees them) are a fact of these cuts, not of the object: the partition runs again with a larger
 /// fit margin, whose smaller regions are cut elsewhere (the armadillo at 550 mm: no order at a
-/// 2 mm or 4 mm margin, 18 pieces put on at 7 mm).
+/// 2 mm or 4 mm margin, 18 pieces put on at 7 mm). With it the tenons keep to the paper's near-
+/// perpendicular kReplanTiltDeg when the user allowed more: a wider tilt gives more pieces pegs
+/// along more directions, and at 550 mm the armadillo's pieces then chose directions that lock
+/// each other at every margin tried (2, 5, 8, 11 mm), while at 35° a 5 mm margin put them on.
 void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunContext& context,
                      const sdf::InteriorField& interior) {
     int refits = 0, replans = 0;
+    RunOptions attempt = options;  // the tenon tilt narrows on a replan; pieces.json records it
     for (;;) {
         partitionSurface(run, options, context);
         try {
-            makePieces(run, options, context, interior);
+            makePieces(run, attempt, context, interior);
             return;
         } catch (const pieces::NotBuildable& e) {
             // A frame of a few balls in a row (no B0 cube fits) reaches little of a large surface:
@@ -152,11 +158,20 @@ void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunConte
             if (++replans > kMaxReplans) throw;
             const double before = run.fabrication.fitMarginMm;
             run.fabrication.fitMarginMm = before + kReplanMarginStepMm;
+            double& tiltDeg = attempt.pieces.tenons.maxTiltDeg;
+            const std::string tilt = tiltDeg > kReplanTiltDeg
+                                         ? formatNumbers(
+                                               " and tenons at most %.0f° off the wall's normal "
+                                               "(was %.0f°)",
+                                               kReplanTiltDeg, tiltDeg)
+                                         : "";
+            tiltDeg = std::min(tiltDeg, kReplanTiltDeg);
             context.info(
                 e.message() +
                 formatNumbers("; partitioning again for smaller pieces, with a fit margin of %.1f mm "
                               "(was %.1f)",
-                              run.fabrication.fitMarginMm, before));
+                              run.fabrication.fitMarginMm, before) +
+                tilt);
         } catch (const pieces::PieceTooLarge& e) {
             if (++refits > kMaxRefits) throw;
             const double before = run.fabrication.fitMarginMm;
