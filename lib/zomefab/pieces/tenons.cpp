@@ -108,8 +108,9 @@ std::string containment(const Tenon& t, int64_t piece, const ShellProbe& probe, 
     return isCentreIn && 3 * endInWall >= 2 * endSamples ? "" : "too close to the piece's edge";
 }
 
-/// One ray's candidate: where it meets the wall, which piece, and why it cannot be a tenon.
-TenonCandidate candidateAlong(const zome::Structure& frame, zome::BallId id, int hole,
+}  // namespace
+
+TenonCandidate tenonCandidate(const zome::Structure& frame, zome::BallId id, int hole,
                               const Transform4d& frameToGridMm, const ShellProbe& probe,
                               const TenonOptions& o) {
     TenonCandidate c;
@@ -157,14 +158,6 @@ TenonCandidate candidateAlong(const zome::Structure& frame, zome::BallId id, int
     c.rejection = containment(t, c.piece, probe, o);
     if (c.rejection.empty()) c.score = cosTilt - 0.5 * t.lengthMm() / o.maxLengthMm;
     return c;
-}
-
-}  // namespace
-
-TenonCandidate tenonCandidate(const zome::Structure& frame, zome::BallId id, int hole,
-                              const Transform4d& frameToGridMm, const ShellProbe& probe,
-                              const TenonOptions& o) {
-    return candidateAlong(frame, id, hole, frameToGridMm, probe, o);
 }
 
 const char* tenonHolesName(TenonHoles holes) {
@@ -347,7 +340,7 @@ std::vector<TenonCandidate> findTenonCandidates(const zome::Structure& frame,
     std::vector<TenonCandidate> out;
     const std::vector<int> holes = tenonHoleSet(o.holes);
     for (zome::BallId id : frame.ballIds())
-        for (int hole : holes) out.push_back(candidateAlong(frame, id, hole, frameToGridMm, probe, o));
+        for (int hole : holes) out.push_back(tenonCandidate(frame, id, hole, frameToGridMm, probe, o));
     return out;
 }
 
