@@ -34,12 +34,15 @@ struct Run {
         exitCode = runInto("out", "--threads 2 --report " + dir.file("report.json"));
     }
     /// zf-pieces on the shared inputs into dir/@p outName with @p options; its exit code. The
-    /// tilt is the paper's near-perpendicular 35°, at which the sphere's four quadrants stay four
-    /// pieces (at the 60° default two are printed as one with a neighbour, which pieces_test covers).
-    int runInto(const std::string& outName, const std::string& options) const {
+    /// tilt is the paper's near-perpendicular 35° and glued groups are off, at which the sphere's
+    /// four quadrants stay four pieces (at the 60° default two are printed as one with a neighbour,
+    /// which pieces_test covers; with glued groups the quadrant glued onto its host is printed with
+    /// it, the case below). @p defaults: only the tilt is set.
+    int runInto(const std::string& outName, const std::string& options, bool isDefault = false) const {
         return test::runShell(test::toolPath("zf-pieces") + " " + dir.file("shell.vdb") + " " +
                               dir.file("frame.json") + " " + dir.file("partition.json") +
-                              " -q --tenon-max-tilt-deg 35 " + options + " -o " + dir.file(outName));
+                              " -q --tenon-max-tilt-deg 35 " + (isDefault ? "" : "--no-glue-groups ") +
+                              options + " -o " + dir.file(outName));
     }
     std::string out(const std::string& name) const { return dir.file("out/" + name); }
 };
@@ -92,6 +95,34 @@ TEST_CASE("zf-pieces: one closed STL per piece, a 3MF per plate and pieces.json"
     const nlohmann::json report = nlohmann::json::parse(test::readFile(r.dir.file("report.json")));
     CHECK(report["pieces"] == 4);
     CHECK(report["tool"] == "zf-pieces");
+}
+
+TEST_CASE("zf-pieces: a piece glued onto its host is printed with it when the two fit the printer") {
+    // Without glued groups one quadrant has no peg and is glued onto a neighbour after it; with
+    // them (the default) the two are printed as one piece (docs/mounting.md, "Glued pairs printed
+    // as one"), and nothing is glued on.
+    const Run& r = shared();
+    REQUIRE(r.exitCode == 0);
+    const nlohmann::json apart = nlohmann::json::parse(test::readFile(r.out("pieces.json")));
+    REQUIRE(r.runInto("glued", "", true) == 0);
+    const nlohmann::json one = nlohmann::json::parse(test::readFile(r.dir.file("glued/pieces.json")));
+    auto noPeg = [](const nlohmann::json& j) {
+        size_t n = 0;
+        for (const nlohmann::json& p : j["pieces"]) n += p["tenons"].empty() ? 1 : 0;
+        return n;
+    };
+    REQUIRE(apart["installation"]["glued_on"].size() == 1);
+    REQUIRE(noPeg(apart) == 1);
+    CHECK(one["pieces"].size() == 3);
+    CHECK(one["summary"]["merged_pieces"] == 1);
+    CHECK(one["installation"]["glued_on"].empty());
+    CHECK(one["installation"]["problems"].empty());
+    CHECK(noPeg(one) == 0);
+    // The shell is all there: the three pieces' volumes sum to the four's.
+    double before = 0, after = 0;
+    for (const nlohmann::json& p : apart["pieces"]) before += p["volume_mm3"].get<double>();
+    for (const nlohmann::json& p : one["pieces"]) after += p["volume_mm3"].get<double>();
+    CHECK(after == doctest::Approx(before).epsilon(0.01));
 }
 
 TEST_CASE("zf-pieces: --tenon-holes lattice keeps the tenons on the paper's six holes") {

@@ -122,8 +122,8 @@ std::vector<std::pair<uint32_t, uint32_t>> disjointPairs(
     return out;
 }
 
-size_t mergeAll(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field,
-                std::vector<std::pair<uint32_t, uint32_t>> pairs) {
+std::vector<uint32_t> mergeAll(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field,
+                               std::vector<std::pair<uint32_t, uint32_t>> pairs) {
     std::vector<uint32_t> now(pieces.size());  // original id → current id
     for (uint32_t p = 0; p < now.size(); ++p) now[p] = p;
     for (const auto& [a, b] : pairs) {
@@ -132,7 +132,7 @@ size_t mergeAll(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelFie
         const uint32_t kept = mergePieces(pieces, sets, field, keep, gone);
         for (uint32_t& id : now) id = id == gone ? kept : (id > gone ? id - 1 : id);
     }
-    return pairs.size();
+    return now;
 }
 
 }  // namespace zomefab::pieces::detail

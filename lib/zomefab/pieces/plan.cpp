@@ -300,7 +300,10 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
     mergeUnderHeld(replanner, fabrication);
     if (opt.isRecuttingPairs) recutUnderHeldPairs(replanner, fabrication);
     // Last: glued groups are pairs of piece numbers, which merges and cuts would change.
-    if (opt.isGluingUnderHeld) glueUnderHeld(replanner);
+    if (opt.isGluingUnderHeld) {
+        glueUnderHeld(replanner);
+        mergeGluedPairs(replanner, fabrication);
+    }
     const size_t unpinned = placePins(out, field, cells, grouping.cellSets, opt, GlueOnRule{}.minCosine);
     if (unpinned > 0)
         context.warn(std::to_string(unpinned) + " of " +

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 #include <tuple>
 
 #include "zomefab/core/format.h"
@@ -159,6 +160,77 @@ Pairs glueUnderHeldOptions(const Replanner& r, const std::vector<size_t>& pegs) 
     return options;
 }
 
+/// Rounds of mergeGluedPairs (each a plan; a round merges one pair per piece).
+constexpr int kGluedMergeRounds = 8;
+/// When a round's merges together do not help, this many are tried one by one.
+constexpr size_t kSingleGluedMergeTrials = 4;
+
+/// The pairs of pieces the maker glues together anyway — neighbours in one glued group, or a piece
+/// and the host it is glued onto — of which one at least is under minPerPiece pegs, that can be
+/// merged (isMergeable) and whose union fits the printer. The smaller pair first (by the smaller
+/// piece's shell volume, then the larger's); deterministic.
+Pairs gluedMergeOptions(const Replanner& r, const Fabrication& fabrication) {
+    const std::vector<size_t> pegs = r.pegs();
+    const size_t minPegs = size_t(r.opt.tenons.minPerPiece);
+    std::set<std::pair<uint32_t, uint32_t>> glued;
+    for (const auto& [a, b] : r.out.plan.gluedOn)
+        if (a != b) glued.insert({std::min(a, b), std::max(a, b)});
+    for (const mount::MountStep& step : r.out.plan.steps)
+        for (uint32_t a : step.pieces)
+            for (const auto& [b, area] : r.out.pieces[a].neighbors)
+                if (a < b && std::count(step.pieces.begin(), step.pieces.end(), b) > 0) glued.insert({a, b});
+    const std::vector<std::vector<size_t>> slots = slotsOfPieces(r.field, r.out.pieces.size());
+    std::vector<std::tuple<double, double, uint32_t, uint32_t>> options;  // (smaller, larger, a, b)
+    for (const auto& [a, b] : glued) {
+        if ((pegs[a] >= minPegs && pegs[b] >= minPegs) || !isMergeable(r.grouping.cellSets, a, b)) continue;
+        std::vector<size_t> both = slots[a];
+        both.insert(both.end(), slots[b].begin(), slots[b].end());
+        r.context.throwIfCancelled();
+        if (!coarseFit(coarseInside(r.field, both), fabrication.pieceBoxMm(), fabrication.fitMarginMm).fits)
+            continue;
+        const double va = r.out.pieces[a].shellVolumeMm3, vb = r.out.pieces[b].shellVolumeMm3;
+        options.push_back({std::min(va, vb), std::max(va, vb), a, b});
+    }
+    std::sort(options.begin(), options.end());
+    Pairs out;
+    for (const auto& [smaller, larger, a, b] : options) out.push_back({a, b});
+    return out;
+}
+
+/// Merges in rounds (tryPairsInRounds) the pairs @p listPairs gives while pieces are under-held:
+/// each trial merges (mergeAll) and plans again, and is kept only when fewer pieces are under-held
+/// with a plan that can be carried out. The groups glued before planning (Replanner::preGlued)
+/// follow the pieces' new numbers; a merged pair is no longer glued. @p what: the pairs, for the
+/// message.
+void mergeInRounds(Replanner& r, int rounds, size_t singles, const std::function<Pairs()>& listPairs,
+                   const std::string& what) {
+    size_t before = 0;
+    auto attempt = [&](const Pairs& pairs) {
+        const std::optional<size_t> after = r.tryChange(
+            [&] {
+                const std::vector<uint32_t> now = mergeAll(r.out.pieces, r.grouping.cellSets, r.field, pairs);
+                std::vector<std::pair<uint32_t, uint32_t>> kept;
+                for (const auto& [a, b] : r.preGlued)
+                    if (now[a] != now[b]) kept.push_back({now[a], now[b]});
+                r.preGlued = std::move(kept);
+            },
+            before, std::to_string(pairs.size()) + " merge(s)");
+        if (!after) return false;
+        r.out.mergedPieces += pairs.size();
+        r.context.detail(std::to_string(pairs.size()) + " " + what + " (" + std::to_string(before) + " -> " +
+                         std::to_string(*after) + " pieces under " +
+                         std::to_string(r.opt.tenons.minPerPiece) + " pegs)");
+        return true;
+    };
+    tryPairsInRounds(
+        r, rounds, singles,
+        [&] {
+            before = r.underHeldNow();
+            return before == 0 ? Pairs{} : listPairs();
+        },
+        attempt);
+}
+
 }  // namespace
 
 void mergeUnderHeld(Replanner& r, const Fabrication& fabrication) {
@@ -168,35 +240,17 @@ void mergeUnderHeld(Replanner& r, const Fabrication& fabrication) {
     search.fitMarginMm = fabrication.fitMarginMm;
     search.minPerPiece = opt.tenons.minPerPiece;
     search.maxPerPiece = opt.tenons.maxPerPiece;
-    const int minPegs = opt.tenons.minPerPiece;
-    // Whether merging @p pairs helped (then it is kept).
-    auto attempt = [&](const Pairs& pairs, size_t before) {
-        const std::optional<size_t> after =
-            r.tryChange([&] { mergeAll(r.out.pieces, r.grouping.cellSets, r.field, pairs); }, before,
-                        std::to_string(pairs.size()) + " merge(s)");
-        if (!after) return false;
-        r.out.mergedPieces += pairs.size();
-        r.context.detail(std::to_string(pairs.size()) +
-                         " piece(s) too few pegs would hold printed as one with a neighbour (" +
-                         std::to_string(before) + " -> " + std::to_string(*after) + " pieces under " +
-                         std::to_string(minPegs) + " pegs)");
-        return true;
-    };
-    size_t before = 0;
-    tryPairsInRounds(
+    mergeInRounds(
         r, kMergeRounds, kSingleMergeTrials,
         [&] {
-            const std::vector<size_t> pegs = r.pegs();
-            before = underHeld(pegs, minPegs);
             Pairs pairs;
-            if (before == 0) return pairs;
             for (const MergeOption& o :
-                 mergeOptions(r.out.pieces, r.grouping.cellSets, r.field, pegs,
+                 mergeOptions(r.out.pieces, r.grouping.cellSets, r.field, r.pegs(),
                               plannerInput(r.out, r.field, r.candidates), r.sweeps, search))
                 pairs.push_back({o.piece, o.neighbor});
             return pairs;
         },
-        [&](const Pairs& pairs) { return attempt(pairs, before); });
+        "piece(s) too few pegs would hold printed as one with a neighbour");
 }
 
 void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication) {
@@ -293,6 +347,12 @@ void glueUnderHeld(Replanner& r) {
             return before == 0 ? Pairs{} : glueUnderHeldOptions(r, pegs);
         },
         [&](const Pairs& pairs) { return attempt(pairs, before); });
+}
+
+void mergeGluedPairs(Replanner& r, const Fabrication& fabrication) {
+    mergeInRounds(
+        r, kGluedMergeRounds, kSingleGluedMergeTrials, [&] { return gluedMergeOptions(r, fabrication); },
+        "glued pair(s) with a piece too few pegs would hold printed as one");
 }
 
 }  // namespace zomefab::pieces::detail

@@ -56,8 +56,9 @@ std::vector<MergeOption> mergeOptions(const std::vector<Piece>& pieces, const st
 std::vector<std::pair<uint32_t, uint32_t>> disjointPairs(
     const std::vector<std::pair<uint32_t, uint32_t>>& pairs);
 
-/// Merges every pair of @p pairs (ids as before any of them), in order. Returns how many.
-size_t mergeAll(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field,
-                std::vector<std::pair<uint32_t, uint32_t>> pairs);
+/// Merges every pair of @p pairs (ids as before any of them), in order. Returns each piece's id
+/// after the merges, by its id before them (a merged piece: the id of the piece it became part of).
+std::vector<uint32_t> mergeAll(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field,
+                               std::vector<std::pair<uint32_t, uint32_t>> pairs);
 
 }  // namespace zomefab::pieces::detail

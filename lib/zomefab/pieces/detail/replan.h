@@ -174,4 +174,12 @@ void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication);
 /// step in one pair), then, when that does not help, the options one by one (kSingleGlueTrials).
 void glueUnderHeld(Replanner& r);
 
+/// Pieces glued together (neighbours in one glued group, or a piece and the host it is glued onto)
+/// of which one at least has fewer than minPerPiece pegs, whose union fits the printer, are printed
+/// as one and the plan made again: the maker glues them anyway, and one piece fewer is under-held
+/// (the dino at 500 mm: two toes glued to a leg glued to the body). Kept when fewer pieces are under-held
+/// with a plan that can be carried out; the groups glued before planning (Replanner::preGlued) follow the
+/// pieces' new numbers. Rounds as mergeUnderHeld's. Run after glueUnderHeld, whose groups it merges.
+void mergeGluedPairs(Replanner& r, const Fabrication& fabrication);
+
 }  // namespace zomefab::pieces::detail
