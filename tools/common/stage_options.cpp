@@ -260,7 +260,8 @@ void PiecesCli::addTo(CLI::App& app) {
                  "Cut a piece fewer than --min-tenons pegs hold anew with a neighbour so both are held "
                  "(more pegs, more support to print)");
     app.add_flag("--no-glue-groups", isNotGluing,
-                 "Do not glue a piece fewer than --min-tenons pegs hold to a neighbour before mounting");
+                 "Do not glue a piece fewer than --min-tenons pegs hold to a neighbour before mounting, nor print "
+                 "pieces glued together as one");
     app.add_flag("--no-label", isUnlabelled, "Do not engrave piece numbers");
     app.add_option("--label-height-mm", o.label.heightMm, "Height of the engraved digits")
         ->capture_default_str();
