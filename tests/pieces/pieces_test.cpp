@@ -23,6 +23,7 @@
 #include "zomefab/pieces/detail/box_distance.h"
 #include "zomefab/pieces/detail/grouping.h"
 #include "zomefab/pieces/detail/merges.h"
+#include "zomefab/pieces/detail/replan.h"
 #include "zomefab/pieces/detail/splits.h"
 #include "zomefab/pieces/detail/voxels.h"
 #include "zomefab/pieces/orientation.h"
@@ -713,16 +714,26 @@ TEST_CASE("pieces: every piece fits the bed less its margins and lies centred on
                     Error);
 }
 
-TEST_CASE("pieces: two under-held neighbours are cut anew along a plane that holds both and fits") {
-    // The union of two pieces: a 200 × 40 × 10 mm slab of 2 mm cells (centres on the cells'
-    // lattice), no frame in the way (every path free). Tenon candidates along one hole at x = −80,
-    // −60, 60 and 80 mm: the plane x = −1 (or x = 19, ...) leaves two to each half, and each half fits a
-    // 130 mm box where the whole slab does not (not even across a diagonal).
+namespace {
+
+/// A 200 × 40 × 10 mm slab as the centres of 2 mm cells (on the cells' lattice), centred at the origin.
+CoarseCells slabCells() {
     CoarseCells slab;
     slab.cellMm = 2.0;
     for (int i = -50; i < 50; ++i)
         for (int j = -10; j < 10; ++j)
             for (int k = -2; k < 3; ++k) slab.centresMm.push_back({2.0 * i, 2.0 * j, 2.0 * k});
+    return slab;
+}
+
+}  // namespace
+
+TEST_CASE("pieces: two under-held neighbours are cut anew along a plane that holds both and fits") {
+    // The union of two pieces: a 200 × 40 × 10 mm slab of 2 mm cells (centres on the cells'
+    // lattice), no frame in the way (every path free). Tenon candidates along one hole at x = −80,
+    // −60, 60 and 80 mm: the plane x = −1 (or x = 19, ...) leaves two to each half, and each half fits a
+    // 130 mm box where the whole slab does not (not even across a diagonal).
+    const CoarseCells slab = slabCells();
     const zome::Structure none;
     const FrameSweeps sweeps(none, Transform4d::identity(), Box3d{}, 1.0, 1.0);
     const int hole = 0;
@@ -779,6 +790,73 @@ TEST_CASE("pieces: two under-held neighbours are cut anew along a plane that hol
     CHECK(!findHoldingSplits(slab, pointers(uneven), sweeps, search, box, 1.0, 1, 3).empty());
     // Halves that hold but do not fit a 50 mm box are no answer.
     CHECK(findHoldingSplits(slab, pointers(even), sweeps, search, {50, 50, 50}, 1.0, 2, 3).empty());
+}
+
+TEST_CASE("pieces: a union no plane cuts into two held pieces that fit is cut into three") {
+    // The slab of the case above (200 × 40 × 10 mm) and an 80 mm printer: no half of a plane through
+    // the slab fits with the other (one of them is at least 100 mm long), but three parts of about
+    // 67 mm do. Candidates in pairs at x = −90, −80 | −10, 10 | 80, 90: the first plane leaves one
+    // pair on its fitting side, the second cuts the rest between the other two pairs.
+    const CoarseCells slab = slabCells();
+    const zome::Structure none;
+    const FrameSweeps sweeps(none, Transform4d::identity(), Box3d{}, 1.0, 1.0);
+    std::vector<TenonCandidate> list;
+    for (const double x : {-90.0, -80.0, -10.0, 10.0, 80.0, 90.0}) {
+        TenonCandidate c;
+        c.score = 1.0;
+        c.tenon.ball = zome::BallId(list.size());
+        c.tenon.axisGrid = zome::holeDirection(0);
+        c.tenon.ballCenterGridMm = {x, 0.0, 0.0};
+        list.push_back(c);
+    }
+    std::vector<const TenonCandidate*> candidates;
+    for (const TenonCandidate& c : list) candidates.push_back(&c);
+    SplitSearch search;
+    search.voxelMm = slab.cellMm;
+    search.minVolumeMm3 = 1000.0;
+    const Fabrication printer = printerOf({80, 80, 80});
+    REQUIRE(
+        findHoldingSplits(slab, candidates, sweeps, search, printer.pieceBoxMm(), printer.fitMarginMm, 2, 3)
+            .empty());
+    const std::vector<PairCut> cuts = pairCuts(slab, candidates, sweeps, search, printer, 2);
+    REQUIRE(!cuts.empty());
+    for (const PairCut& cut : cuts) {
+        REQUIRE(cut.second.has_value());
+        // The three parts (0: the first plane's fitting half, 1 and 2: the large half's sides of the
+        // second plane): each fits the printer and keeps two candidates clear of both planes.
+        std::array<std::vector<Vec3d>, 3> byPart;
+        for (const Vec3d& x : slab.centresMm) {
+            const uint8_t side = dot(cut.first.normal, x) > cut.first.offsetMm ? 1 : 0;
+            const size_t part =
+                side != cut.secondSide ? 0 : (dot(cut.second->normal, x) > cut.second->offsetMm ? 2 : 1);
+            byPart[part].push_back(x);
+        }
+        for (const std::vector<Vec3d>& part : byPart) {
+            REQUIRE(!part.empty());
+            CHECK(fitOfSolid(part, printer.pieceBoxMm(), coarseMarginMm(slab, printer.fitMarginMm)).fits);
+        }
+        std::array<size_t, 3> kept{0, 0, 0};
+        for (const TenonCandidate& c : list) {
+            const Vec3d x = c.tenon.pointAt(c.tenon.baseMm);
+            const double a = dot(cut.first.normal, x) - cut.first.offsetMm;
+            const uint8_t side = a > 0 ? 1 : 0;
+            if (std::abs(a) < search.edgeMarginMm) continue;
+            if (side != cut.secondSide) {
+                ++kept[0];
+                continue;
+            }
+            const double b = dot(cut.second->normal, x) - cut.second->offsetMm;
+            if (std::abs(b) >= search.edgeMarginMm) ++kept[b > 0 ? 2 : 1];
+        }
+        CHECK(kept[0] == 2);
+        CHECK(kept[1] == 2);
+        CHECK(kept[2] == 2);
+    }
+    // With a printer the halves fit, two pieces: no second plane.
+    const Fabrication larger = printerOf({130, 130, 130});
+    const std::vector<PairCut> two = pairCuts(slab, candidates, sweeps, search, larger, 2);
+    REQUIRE(!two.empty());
+    CHECK(!two[0].second.has_value());
 }
 
 TEST_CASE("pieces: the support a half needs lying on its cut face, counted on its cells") {

@@ -4,6 +4,7 @@
 #include "zomefab/pieces/detail/replan.h"
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <set>
 #include <tuple>
@@ -35,7 +36,7 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
     if (kind == Change::kFrame) kept.frame = frame;
     change();
     const bool steps = kind == Change::kGroups;
-    if (kind == Change::kPieces)
+    if (kind == Change::kPieces || kind == Change::kMorePieces)
         grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
     else if (kind == Change::kFrame)
         remakeSweeps();
@@ -48,7 +49,11 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
                   std::to_string(opt.tenons.minPerPiece) + " pegs " + std::to_string(before) + " -> " +
                   (after == SIZE_MAX ? std::string("no plan") : std::to_string(after)) + " in " +
                   formatNumber(clock.seconds(), 3) + " s");
-    if (after < before) return after;
+    // kMorePieces: more pieces held (pieces less under-held ones), and no more under-held.
+    const bool isBetter = kind == Change::kMorePieces
+                              ? after <= before && out.pieces.size() - after > kept.pieces.size() - before
+                              : after < before;
+    if (isBetter) return after;
     out.pieces = std::move(kept.pieces);
     grouping.cellSets = std::move(kept.cellSets);
     grouping.faces = std::move(kept.faces);
@@ -233,6 +238,37 @@ void mergeInRounds(Replanner& r, int rounds, size_t singles, const std::function
 
 }  // namespace
 
+std::vector<PairCut> pairCuts(const CoarseCells& cells, const std::vector<const TenonCandidate*>& candidates,
+                              const FrameSweeps& sweeps, const SplitSearch& search,
+                              const Fabrication& fabrication, size_t minPegs) {
+    const Vec3d box = fabrication.pieceBoxMm();
+    const double margin = fabrication.fitMarginMm;
+    std::vector<PairCut> out;
+    for (const SplitPlane& plane :
+         findHoldingSplits(cells, candidates, sweeps, search, box, margin, minPegs, kPlanesPerPair))
+        out.push_back({plane, std::nullopt, 0});
+    if (!out.empty()) return out;
+    for (const SplitPlane& first :
+         findHoldingSplits(cells, candidates, sweeps, search, box, margin, minPegs, kPlanesPerPair, 1)) {
+        std::array<CoarseCells, 2> halves;
+        for (CoarseCells& h : halves) h.cellMm = cells.cellMm;
+        for (const Vec3d& x : cells.centresMm)
+            halves[dot(first.normal, x) > first.offsetMm].centresMm.push_back(x);
+        const uint8_t large = coarseFit(halves[0], box, margin).fits ? 1 : 0;
+        // The large half's candidates: those findHoldingSplits counted for it (clear of the plane).
+        const double sign = large ? 1.0 : -1.0;
+        std::vector<const TenonCandidate*> mine;
+        for (const TenonCandidate* c : candidates)
+            if (sign * (dot(first.normal, c->tenon.pointAt(c->tenon.baseMm)) - first.offsetMm) >=
+                search.edgeMarginMm)
+                mine.push_back(c);
+        for (const SplitPlane& second :
+             findHoldingSplits(halves[large], mine, sweeps, search, box, margin, minPegs, kPlanesPerPair))
+            out.push_back({first, second, large});
+    }
+    return out;
+}
+
 void mergeUnderHeld(Replanner& r, const Fabrication& fabrication) {
     const PiecesOptions& opt = r.opt;
     MergeSearch search;
@@ -282,32 +318,40 @@ void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication) {
                 const CoarseCells union_ = coarseInside(r.field, both);
                 if (coarseFit(union_, fabrication.pieceBoxMm(), fabrication.fitMarginMm).fits)
                     continue;  // a merge would do; mergeUnderHeld found it no better
-                const std::vector<const TenonCandidate*> mine = usableCandidates(r.candidates, {p, q});
                 search.voxelMm = union_.cellMm;
                 ++searches;
                 const Stopwatch clock;
-                const std::vector<SplitPlane> planes =
-                    findHoldingSplits(union_, mine, r.sweeps, search, fabrication.pieceBoxMm(),
-                                      fabrication.fitMarginMm, minPegs, kPlanesPerPair);
+                const std::vector<PairCut> cuts = pairCuts(union_, usableCandidates(r.candidates, {p, q}),
+                                                           r.sweeps, search, fabrication, minPegs);
                 r.context.debug("mounting: pieces " + std::to_string(p) + " and " + std::to_string(q) + ": " +
-                                std::to_string(planes.size()) + " plane(s) that hold both, in " +
+                                std::to_string(cuts.size()) + " cut(s) that hold every part, in " +
                                 formatNumber(clock.seconds(), 3) + " s");
                 const std::string pair = std::to_string(p) + " and " + std::to_string(q);
-                for (size_t k2 = 0; k2 < planes.size() && !isCut && trials < kPairTrials; ++k2) {
+                for (size_t c = 0; c < cuts.size() && !isCut && trials < kPairTrials; ++c) {
                     ++trials;
+                    const PairCut& cut = cuts[c];
+                    const std::string into = cut.second ? "three pieces" : "two other pieces";
                     const std::optional<size_t> after = r.tryChange(
                         [&] {
                             const uint32_t kept = mergePieces(r.out.pieces, r.grouping.cellSets, r.field,
                                                               std::min(p, q), std::max(p, q));
-                            splitPiece(r.out.pieces, r.grouping.cellSets, r.field, kept, planes[k2]);
+                            const uint32_t beyond =
+                                splitPiece(r.out.pieces, r.grouping.cellSets, r.field, kept, cut.first);
+                            if (cut.second)
+                                splitPiece(r.out.pieces, r.grouping.cellSets, r.field,
+                                           cut.secondSide ? beyond : kept, *cut.second);
                         },
-                        before, "pieces " + pair + " cut anew");
+                        before, "pieces " + pair + " cut anew into " + into,
+                        cut.second ? Replanner::Change::kMorePieces : Replanner::Change::kPieces);
                     if (!after) continue;
                     ++r.out.recutPairs;
-                    r.context.detail("pieces " + pair +
-                                     " cut anew along another plane, so that both are held (" +
-                                     std::to_string(before) + " -> " + std::to_string(*after) +
-                                     " pieces under " + std::to_string(minPegs) + " pegs)");
+                    // Pieces held by minPerPiece pegs or more: a cut into three adds one.
+                    const size_t heldBefore = r.out.pieces.size() - (cut.second ? 1 : 0) - before;
+                    r.context.detail("pieces " + pair + " cut anew into " + into + " (pieces under " +
+                                     std::to_string(minPegs) + " pegs " + std::to_string(before) + " -> " +
+                                     std::to_string(*after) + ", held by " + std::to_string(minPegs) +
+                                     " or more " + std::to_string(heldBefore) + " -> " +
+                                     std::to_string(r.out.pieces.size() - *after) + ")");
                     isCut = true;
                 }
                 if (trials == kPairTrials) return;

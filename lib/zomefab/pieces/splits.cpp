@@ -15,6 +15,7 @@
 #include "zomefab/mount/plan.h"
 #include "zomefab/partition/printer_fit.h"
 #include "zomefab/pieces/detail/support.h"
+#include "zomefab/zome/holes.h"
 
 namespace zomefab::pieces::detail {
 
@@ -253,15 +254,24 @@ std::vector<SplitPlane> findHoldingSplits(const CoarseCells& cells,
                                           const std::vector<const TenonCandidate*>& candidates,
                                           const FrameSweeps& sweeps, const SplitSearch& search,
                                           const Vec3d& printerMm, double marginMm, size_t minTenons,
-                                          size_t maxPlanes) {
+                                          size_t maxPlanes, int minFitting) {
     const std::vector<Vec3d>& voxels = cells.centresMm;
     // Each half needs minTenons candidates of its own.
     if (voxels.size() < 2 || minTenons == 0 || candidates.size() < 2 * minTenons) return {};
     const VoxelGraph graph = voxelGraph(voxels, search);
+    // The grid's 13 directions and the frame's 31 Zome axes (a cut across a limb is often square to
+    // one of them), through percentiles from the 20th to the 80th: the search is cheap next to a
+    // plan (most planes leave one side too few candidates and cost no path test).
+    std::vector<Vec3d> normals = splitDirections();
+    for (int hole = 0; hole < zome::kHoleCount; ++hole) {
+        const Vec3d n = gridDirection(hole, sweeps.frameToGridMm());
+        const bool isNew = std::none_of(normals.begin(), normals.end(),
+                                        [&](const Vec3d& m) { return std::abs(dot(m, n)) > 0.9999; });
+        if (isNew) normals.push_back(n);
+    }
     std::vector<SplitPlane> planes;
-    for (const double quantile : {0.5, 0.4, 0.6, 1.0 / 3.0, 2.0 / 3.0})
-        for (const Vec3d& n : splitDirections())
-            planes.push_back(planeAt(voxels, n, quantile, search.voxelMm));
+    for (const double quantile : {0.5, 0.4, 0.6, 1.0 / 3.0, 2.0 / 3.0, 0.45, 0.55, 0.25, 0.75, 0.2, 0.8})
+        for (const Vec3d& n : normals) planes.push_back(planeAt(voxels, n, quantile, search.voxelMm));
     // The tenons first (in parallel: the sweeps are thread-safe), the fit only for planes whose
     // halves are both held well enough, best first; ties in plane order (deterministic).
     std::vector<SplitValue> values(planes.size(), {0, 0, 0});
@@ -292,9 +302,10 @@ std::vector<SplitPlane> findHoldingSplits(const CoarseCells& cells,
         // Searched on fewer extremes (a box up to a few tenths of a mm from the best can be
         // missed, never one too small: the box is measured on every cell), as the search
         // tries many planes; the pieces are fitted again with their tenons (splitOverPrinter).
-        if (!fitOfSolid(halves[0], printerMm, margin, kSearchDirections).fits ||
-            !fitOfSolid(halves[1], printerMm, margin, kSearchDirections).fits)
-            continue;
+        int fits = 0;
+        for (const std::vector<Vec3d>& half : halves)
+            fits += fitOfSolid(half, printerMm, margin, kSearchDirections).fits ? 1 : 0;
+        if (fits < minFitting || (minFitting < 2 && fits == 2)) continue;
         const double support =
             restingSupportMm3(halves[0], scale(planes[i].normal, -1.0), -planes[i].offsetMm, cells.cellMm) +
             restingSupportMm3(halves[1], planes[i].normal, planes[i].offsetMm, cells.cellMm);

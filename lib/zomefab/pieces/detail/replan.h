@@ -105,11 +105,15 @@ public:
         kPieces,  ///< the pieces, their cell sets and the voxels' owners: pieces under-held count
         kGroups,  ///< preGlued only (the pieces, faces and candidates stay): steps under-held count
         kFrame,   ///< the frame (grown): its sweeps and the tenon candidates; pieces under-held count
+        /// as kPieces, for a change that adds pieces: judged by the pieces held (minPerPiece pegs
+        /// or more), which must grow, and the under-held ones, which must not
+        kMorePieces,
     };
     /// Makes @p change, recomputes what it touched (for kPieces the faces and the tenon candidates,
     /// for kFrame the sweeps and the candidates) and plans again. Returns the new count of under-held pieces
     /// (kGroups: steps) when it is below
-    /// @p before with a plan that can be carried out; else undoes everything and returns nothing.
+    /// @p before with a plan that can be carried out (kMorePieces: not above @p before, with more
+    /// pieces held); else undoes everything and returns nothing.
     std::optional<size_t> tryChange(const std::function<void()>& change, size_t before,
                                     const std::string& what, Change kind = Change::kPieces);
 
@@ -157,6 +161,25 @@ size_t growFrameForPieces(Replanner& r, const StrutTest& canGrow);
 /// round tries every piece's best merge at once, and when that does not help, the merges one by one
 /// (at most kSingleMergeTrials); a trial that does not help is undone.
 void mergeUnderHeld(Replanner& r, const Fabrication& fabrication);
+
+/// A union of two pieces cut anew: along @p first, and where that leaves a half too large for the
+/// printer, that half (secondSide: 0 the side normal·x ≤ offset, 1 beyond) along @p second.
+struct PairCut {
+    SplitPlane first;
+    std::optional<SplitPlane> second;
+    uint8_t secondSide = 0;
+};
+
+/// The cuts recutUnderHeldPairs tries on a union (@p cells, its coarse cells; @p candidates, its
+/// usable tenon candidates; @p search.voxelMm the cells' side), best first: the planes of
+/// findHoldingSplits whose halves are both held (@p minPegs candidates along a free direction) and
+/// fit the printer; where there is none, three pieces: a plane whose halves are both held and of
+/// which one fits, then a plane of the same search through the other half (with its candidates,
+/// those clear of the first plane) whose halves are both held and fit — a limb glued to a body too
+/// large to print with it gets a part of the body its pegs can reach. At most 3 planes each.
+std::vector<PairCut> pairCuts(const CoarseCells& cells, const std::vector<const TenonCandidate*>& candidates,
+                              const FrameSweeps& sweeps, const SplitSearch& search,
+                              const Fabrication& fabrication, size_t minPegs);
 
 /// A piece fewer than minPerPiece pegs hold whose union with a neighbour does not fit the printer
 /// (so no merge helps) is cut anew with it: the two become one and are cut again along a plane of

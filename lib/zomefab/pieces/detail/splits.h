@@ -111,17 +111,18 @@ partition::PrinterFit coarseFit(const CoarseCells& cells, const Vec3d& printerMm
 /// that each half has a free direction with at least @p minTenons of @p candidates (the two pieces'
 /// usable ones), ordered across the plane, and fits @p printerMm (each box side grown by
 /// @p marginMm): where the partition's seam left both pieces, or one, under-held, another plane
-/// through their union may hold both. Planes: findSplit's 13 directions through the 33rd, 40th,
-/// 50th, 60th and 67th percentiles. Of the best held (the most tenons in the weaker half, then
-/// both) that fit, up to 8, at most @p maxPlanes are returned, those whose halves need the least
-/// support lying on their new cut face first (restingSupportMm3); the plan made again decides
-/// which helps. @p search.voxelMm is the cells' side. Empty when no plane does. docs/mounting.md,
-/// "Pairs cut anew".
+/// through their union may hold both. Planes: findSplit's 13 directions and the frame's 31 Zome
+/// axes through the 20th to the 80th percentiles (11). Of the best held (the most tenons in the weaker half,
+/// then both) that fit, up to 8, at most @p maxPlanes are returned, those whose halves need the least support
+/// lying on their new cut face first (restingSupportMm3); the plan made again decides which helps. @p
+/// search.voxelMm is the cells' side. Empty when no plane does. With @p minFitting 1, the planes of which
+/// exactly one half fits instead (the other is cut again, by a plane of this search on it: a union three
+/// pieces are needed for). docs/mounting.md, "Pairs cut anew".
 std::vector<SplitPlane> findHoldingSplits(const CoarseCells& cells,
                                           const std::vector<const TenonCandidate*>& candidates,
                                           const FrameSweeps& sweeps, const SplitSearch& search,
                                           const Vec3d& printerMm, double marginMm, size_t minTenons,
-                                          size_t maxPlanes);
+                                          size_t maxPlanes, int minFitting = 2);
 
 /// The support a half needs printed lying on its cut face, estimated on its cells (of side
 /// @p cellMm): the plane {x : up·x = @p offsetMm} is the bed and @p up (unit) points into the half;
