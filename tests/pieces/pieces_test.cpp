@@ -766,7 +766,7 @@ TEST_CASE("pieces: two under-held neighbours are cut anew along a plane that hol
     const std::vector<TenonCandidate> even = candidatesAt({-80, -60, 60, 80});
     REQUIRE_FALSE(fitOfSolid(slab.centresMm, box, 1.0).fits);
     const std::vector<SplitPlane> planes =
-        findHoldingSplits(slab, pointers(even), sweeps, search, box, 1.0, 2, 3);
+        findHoldingSplits(slab, pointers(even), sweeps, search, box, 1.0, 2, 3).bothFit;
     REQUIRE(!planes.empty());
     CHECK(planes.size() <= 3);
     const SplitPlane* plane = &planes[0];
@@ -781,15 +781,15 @@ TEST_CASE("pieces: two under-held neighbours are cut anew along a plane that hol
     // first): through the slab's centre, within a cell.
     CHECK(std::abs(plane->offsetMm) <= slab.cellMm);
     const std::vector<SplitPlane> one =
-        findHoldingSplits(slab, pointers(even), sweeps, search, box, 1.0, 2, 1);
+        findHoldingSplits(slab, pointers(even), sweeps, search, box, 1.0, 2, 1).bothFit;
     REQUIRE(one.size() == 1);
     CHECK(one[0].offsetMm == plane->offsetMm);
     // Three candidates on one side and one on the other: no plane gives both halves two, one does.
     const std::vector<TenonCandidate> uneven = candidatesAt({-80, -70, -60, 70});
-    CHECK(findHoldingSplits(slab, pointers(uneven), sweeps, search, box, 1.0, 2, 3).empty());
-    CHECK(!findHoldingSplits(slab, pointers(uneven), sweeps, search, box, 1.0, 1, 3).empty());
+    CHECK(findHoldingSplits(slab, pointers(uneven), sweeps, search, box, 1.0, 2, 3).bothFit.empty());
+    CHECK(!findHoldingSplits(slab, pointers(uneven), sweeps, search, box, 1.0, 1, 3).bothFit.empty());
     // Halves that hold but do not fit a 50 mm box are no answer.
-    CHECK(findHoldingSplits(slab, pointers(even), sweeps, search, {50, 50, 50}, 1.0, 2, 3).empty());
+    CHECK(findHoldingSplits(slab, pointers(even), sweeps, search, {50, 50, 50}, 1.0, 2, 3).bothFit.empty());
 }
 
 TEST_CASE("pieces: a union no plane cuts into two held pieces that fit is cut into three") {
@@ -817,7 +817,7 @@ TEST_CASE("pieces: a union no plane cuts into two held pieces that fit is cut in
     const Fabrication printer = printerOf({80, 80, 80});
     REQUIRE(
         findHoldingSplits(slab, candidates, sweeps, search, printer.pieceBoxMm(), printer.fitMarginMm, 2, 3)
-            .empty());
+            .bothFit.empty());
     const std::vector<PairCut> cuts = pairCuts(slab, candidates, sweeps, search, printer, 2);
     REQUIRE(!cuts.empty());
     for (const PairCut& cut : cuts) {

@@ -89,9 +89,8 @@ std::vector<MergeOption> mergeOptions(const std::vector<Piece>& pieces, const st
         std::vector<MergeOption> mine;
         for (const auto& [q, area] : pieces[p].neighbors) {
             if (!isMergeable(sets, p, q)) continue;
-            std::vector<size_t> both = slots[p];
-            both.insert(both.end(), slots[q].begin(), slots[q].end());
-            if (!coarseFit(coarseInside(field, both), search.printerMm, search.fitMarginMm).fits) continue;
+            if (!coarseFit(coarseUnion(field, slots[p], slots[q]), search.printerMm, search.fitMarginMm).fits)
+                continue;
             const MountBody body = makeBody({std::min(p, q), std::max(p, q)}, input, sweeps, field.voxelMm,
                                             search.maxPerPiece, 1);
             const DirectionOption* free = body.bestFree();

@@ -188,10 +188,10 @@ Pairs gluedMergeOptions(const Replanner& r, const Fabrication& fabrication) {
     std::vector<std::tuple<double, double, uint32_t, uint32_t>> options;  // (smaller, larger, a, b)
     for (const auto& [a, b] : glued) {
         if ((pegs[a] >= minPegs && pegs[b] >= minPegs) || !isMergeable(r.grouping.cellSets, a, b)) continue;
-        std::vector<size_t> both = slots[a];
-        both.insert(both.end(), slots[b].begin(), slots[b].end());
         r.context.throwIfCancelled();
-        if (!coarseFit(coarseInside(r.field, both), fabrication.pieceBoxMm(), fabrication.fitMarginMm).fits)
+        if (!coarseFit(coarseUnion(r.field, slots[a], slots[b]), fabrication.pieceBoxMm(),
+                       fabrication.fitMarginMm)
+                 .fits)
             continue;
         const double va = r.out.pieces[a].shellVolumeMm3, vb = r.out.pieces[b].shellVolumeMm3;
         options.push_back({std::min(va, vb), std::max(va, vb), a, b});
@@ -243,13 +243,11 @@ std::vector<PairCut> pairCuts(const CoarseCells& cells, const std::vector<const 
                               const Fabrication& fabrication, size_t minPegs) {
     const Vec3d box = fabrication.pieceBoxMm();
     const double margin = fabrication.fitMarginMm;
+    const HoldingSplits splits =
+        findHoldingSplits(cells, candidates, sweeps, search, box, margin, minPegs, kPlanesPerPair);
     std::vector<PairCut> out;
-    for (const SplitPlane& plane :
-         findHoldingSplits(cells, candidates, sweeps, search, box, margin, minPegs, kPlanesPerPair))
-        out.push_back({plane, std::nullopt, 0});
-    if (!out.empty()) return out;
-    for (const SplitPlane& first :
-         findHoldingSplits(cells, candidates, sweeps, search, box, margin, minPegs, kPlanesPerPair, 1)) {
+    for (const SplitPlane& plane : splits.bothFit) out.push_back({plane, std::nullopt, 0});
+    for (const SplitPlane& first : splits.oneFits) {
         std::array<CoarseCells, 2> halves;
         for (CoarseCells& h : halves) h.cellMm = cells.cellMm;
         for (const Vec3d& x : cells.centresMm)
@@ -263,7 +261,8 @@ std::vector<PairCut> pairCuts(const CoarseCells& cells, const std::vector<const 
                 search.edgeMarginMm)
                 mine.push_back(c);
         for (const SplitPlane& second :
-             findHoldingSplits(halves[large], mine, sweeps, search, box, margin, minPegs, kPlanesPerPair))
+             findHoldingSplits(halves[large], mine, sweeps, search, box, margin, minPegs, kPlanesPerPair)
+                 .bothFit)
             out.push_back({first, second, large});
     }
     return out;
@@ -313,9 +312,7 @@ void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication) {
             for (size_t k = 0; k < byFace.size() && !isCut && searches < kPairSearches; ++k) {
                 r.context.throwIfCancelled();
                 const uint32_t q = byFace[k].second;
-                std::vector<size_t> both = slots[p];
-                both.insert(both.end(), slots[q].begin(), slots[q].end());
-                const CoarseCells union_ = coarseInside(r.field, both);
+                const CoarseCells union_ = coarseUnion(r.field, slots[p], slots[q]);
                 if (coarseFit(union_, fabrication.pieceBoxMm(), fabrication.fitMarginMm).fits)
                     continue;  // a merge would do; mergeUnderHeld found it no better
                 search.voxelMm = union_.cellMm;

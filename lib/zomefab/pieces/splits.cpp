@@ -250,11 +250,10 @@ std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
     return best;
 }
 
-std::vector<SplitPlane> findHoldingSplits(const CoarseCells& cells,
-                                          const std::vector<const TenonCandidate*>& candidates,
-                                          const FrameSweeps& sweeps, const SplitSearch& search,
-                                          const Vec3d& printerMm, double marginMm, size_t minTenons,
-                                          size_t maxPlanes, int minFitting) {
+HoldingSplits findHoldingSplits(const CoarseCells& cells,
+                                const std::vector<const TenonCandidate*>& candidates,
+                                const FrameSweeps& sweeps, const SplitSearch& search, const Vec3d& printerMm,
+                                double marginMm, size_t minTenons, size_t maxPlanes) {
     const std::vector<Vec3d>& voxels = cells.centresMm;
     // Each half needs minTenons candidates of its own.
     if (voxels.size() < 2 || minTenons == 0 || candidates.size() < 2 * minTenons) return {};
@@ -294,29 +293,36 @@ std::vector<SplitPlane> findHoldingSplits(const CoarseCells& cells,
         if (std::get<0>(values[i]) == 2 && std::get<1>(values[i]) >= minTenons) order.push_back(i);
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return values[a] > values[b]; });
     const double margin = coarseMarginMm(cells, marginMm);
-    std::vector<std::pair<double, size_t>> fitting;  // (support of the halves, plane)
+    // (support of the halves, plane), by the halves that fit: [1] one, [2] both.
+    std::array<std::vector<std::pair<double, size_t>>, 3> fitting;
     for (size_t i : order) {
-        if (fitting.size() == kFittingPlanes) break;
+        if (fitting[2].size() == kFittingPlanes) break;
         std::array<std::vector<Vec3d>, 2> halves;
         for (const Vec3d& x : voxels) halves[dot(planes[i].normal, x) > planes[i].offsetMm].push_back(x);
         // Searched on fewer extremes (a box up to a few tenths of a mm from the best can be
         // missed, never one too small: the box is measured on every cell), as the search
         // tries many planes; the pieces are fitted again with their tenons (splitOverPrinter).
-        int fits = 0;
+        size_t fits = 0;
         for (const std::vector<Vec3d>& half : halves)
             fits += fitOfSolid(half, printerMm, margin, kSearchDirections).fits ? 1 : 0;
-        if (fits < minFitting || (minFitting < 2 && fits == 2)) continue;
+        if (fits == 0 || fitting[fits].size() == kFittingPlanes) continue;
         const double support =
             restingSupportMm3(halves[0], scale(planes[i].normal, -1.0), -planes[i].offsetMm, cells.cellMm) +
             restingSupportMm3(halves[1], planes[i].normal, planes[i].offsetMm, cells.cellMm);
-        fitting.push_back({support, i});
+        fitting[fits].push_back({support, i});
     }
     // The halves that print with the least support first: a plane can leave a half that lies on
     // no face (on the demo one such cut cost 9 h of print time more than the pair before it).
-    std::stable_sort(fitting.begin(), fitting.end(),
-                     [](const auto& a, const auto& b) { return a.first < b.first; });
-    std::vector<SplitPlane> out;
-    for (size_t k = 0; k < fitting.size() && k < maxPlanes; ++k) out.push_back(planes[fitting[k].second]);
+    auto best = [&](std::vector<std::pair<double, size_t>>& list) {
+        std::stable_sort(list.begin(), list.end(),
+                         [](const auto& a, const auto& b) { return a.first < b.first; });
+        std::vector<SplitPlane> out;
+        for (size_t k = 0; k < list.size() && k < maxPlanes; ++k) out.push_back(planes[list[k].second]);
+        return out;
+    };
+    HoldingSplits out;
+    out.bothFit = best(fitting[2]);
+    if (out.bothFit.empty()) out.oneFits = best(fitting[1]);
     return out;
 }
 
@@ -388,6 +394,12 @@ CoarseCells coarseInside(const VoxelField& field, const std::vector<size_t>& slo
         out.centresMm.push_back(add(corner, scale(Vec3d{1, 1, 1}, half * field.voxelMm)));
     }
     return out;
+}
+
+CoarseCells coarseUnion(const VoxelField& field, const std::vector<size_t>& a, const std::vector<size_t>& b) {
+    std::vector<size_t> both = a;
+    both.insert(both.end(), b.begin(), b.end());
+    return coarseInside(field, both);
 }
 
 double coarseMarginMm(const CoarseCells& cells, double marginMm) {

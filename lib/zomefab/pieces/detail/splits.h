@@ -102,6 +102,8 @@ struct CoarseCells {
     double cellMm = 0.0;           ///< the cells' side
 };
 CoarseCells coarseInside(const VoxelField& field, const std::vector<size_t>& slots);
+/// coarseInside of two pieces' slots together (@p a, then @p b): their union printed as one piece.
+CoarseCells coarseUnion(const VoxelField& field, const std::vector<size_t>& a, const std::vector<size_t>& b);
 /// @p marginMm grown by the half diagonal of a cell: the fit margin for the cells' centres.
 double coarseMarginMm(const CoarseCells& cells, double marginMm);
 /// The printer fit of @p cells (fitOfSolid), each box side grown by coarseMarginMm.
@@ -114,15 +116,19 @@ partition::PrinterFit coarseFit(const CoarseCells& cells, const Vec3d& printerMm
 /// through their union may hold both. Planes: findSplit's 13 directions and the frame's 31 Zome
 /// axes through the 20th to the 80th percentiles (11). Of the best held (the most tenons in the weaker half,
 /// then both) that fit, up to 8, at most @p maxPlanes are returned, those whose halves need the least support
-/// lying on their new cut face first (restingSupportMm3); the plan made again decides which helps. @p
-/// search.voxelMm is the cells' side. Empty when no plane does. With @p minFitting 1, the planes of which
-/// exactly one half fits instead (the other is cut again, by a plane of this search on it: a union three
-/// pieces are needed for). docs/mounting.md, "Pairs cut anew".
-std::vector<SplitPlane> findHoldingSplits(const CoarseCells& cells,
-                                          const std::vector<const TenonCandidate*>& candidates,
-                                          const FrameSweeps& sweeps, const SplitSearch& search,
-                                          const Vec3d& printerMm, double marginMm, size_t minTenons,
-                                          size_t maxPlanes, int minFitting = 2);
+/// lying on their new cut face first (restingSupportMm3); the plan made again decides which helps.
+/// @p search.voxelMm is the cells' side. bothFit is empty when no plane does; then oneFits holds,
+/// chosen the same way, the planes whose halves are both held and of which exactly one fits (the
+/// other is cut again by this search on it: a union three pieces are needed for). One evaluation of
+/// the planes serves both. docs/mounting.md, "Pairs cut anew".
+struct HoldingSplits {
+    std::vector<SplitPlane> bothFit;
+    std::vector<SplitPlane> oneFits;  ///< only when bothFit is empty
+};
+HoldingSplits findHoldingSplits(const CoarseCells& cells,
+                                const std::vector<const TenonCandidate*>& candidates,
+                                const FrameSweeps& sweeps, const SplitSearch& search, const Vec3d& printerMm,
+                                double marginMm, size_t minTenons, size_t maxPlanes);
 
 /// The support a half needs printed lying on its cut face, estimated on its cells (of side
 /// @p cellMm): the plane {x : up·x = @p offsetMm} is the bed and @p up (unit) points into the half;
