@@ -320,8 +320,7 @@ HoldingSplits findHoldingSplits(const CoarseCells& cells,
         for (size_t k = 0; k < list.size() && k < maxPlanes; ++k) out.push_back(planes[list[k].second]);
         return out;
     };
-    HoldingSplits out;
-    out.bothFit = best(fitting[2]);
+    HoldingSplits out{best(fitting[2]), {}};
     if (out.bothFit.empty()) out.oneFits = best(fitting[1]);
     return out;
 }
@@ -394,12 +393,6 @@ CoarseCells coarseInside(const VoxelField& field, const std::vector<size_t>& slo
         out.centresMm.push_back(add(corner, scale(Vec3d{1, 1, 1}, half * field.voxelMm)));
     }
     return out;
-}
-
-CoarseCells coarseUnion(const VoxelField& field, const std::vector<size_t>& a, const std::vector<size_t>& b) {
-    std::vector<size_t> both = a;
-    both.insert(both.end(), b.begin(), b.end());
-    return coarseInside(field, both);
 }
 
 double coarseMarginMm(const CoarseCells& cells, double marginMm) {

@@ -103,7 +103,12 @@ struct CoarseCells {
 };
 CoarseCells coarseInside(const VoxelField& field, const std::vector<size_t>& slots);
 /// coarseInside of two pieces' slots together (@p a, then @p b): their union printed as one piece.
-CoarseCells coarseUnion(const VoxelField& field, const std::vector<size_t>& a, const std::vector<size_t>& b);
+inline CoarseCells coarseUnion(const VoxelField& field, const std::vector<size_t>& a,
+                               const std::vector<size_t>& b) {
+    std::vector<size_t> both = a;
+    both.insert(both.end(), b.begin(), b.end());
+    return coarseInside(field, both);
+}
 /// @p marginMm grown by the half diagonal of a cell: the fit margin for the cells' centres.
 double coarseMarginMm(const CoarseCells& cells, double marginMm);
 /// The printer fit of @p cells (fitOfSolid), each box side grown by coarseMarginMm.
