@@ -327,6 +327,62 @@ TEST_CASE("tenons: used holes, obstacles, oblique walls and cut edges are reject
         if (c.tenon.hole == 0) CHECK(c.rejection == "crosses another piece");
 }
 
+TEST_CASE("tenons: a thin wall met obliquely holds a stem cut parallel to its outer surface") {
+    // A ball 76.5 mm off the centre of a 4 mm spherical wall (radii 96 and 100): its +y ray meets
+    // the wall at 53°, where a square end cannot be buried in 4 mm. The stem runs through the wall
+    // and is cut by a plane a skin inside the outer surface: it bonds across the whole wall and
+    // nothing of it shows outside.
+    zome::Structure off;
+    off.addBall(zome::strutVector(0, 1));
+    TenonOptions o;
+    o.maxLengthMm = 100;
+    o.holes = TenonHoles::Lattice;
+    for (const double outer : {100.0, 40.0}) {
+        // The second: a ball at the centre of a small sphere (radii 36 and 40) seen along its
+        // axes straight on (no cut), and obliquely by an off-centre one (below).
+        CAPTURE(outer);
+        ShellProbe probe = sphereProbe(outer - 4.0, outer);
+        probe.wallMm = 4.0;
+        const zome::Structure& frame = outer > 50 ? off : oneBall();
+        int cut = 0;
+        for (const TenonCandidate& c : findTenonCandidates(frame, Transform4d::identity(), probe, o)) {
+            CAPTURE(c.tenon.hole);
+            if (!c.rejection.empty()) continue;
+            const Tenon& t = c.tenon;
+            if (t.isClipped()) {
+                ++cut;
+                CHECK(t.tiltDeg > 30.0);
+                // The axis meets the plane inside the wall, past the inner surface.
+                const double axisAtPlane = (t.clipOffsetMm - dot(t.clipNormalGrid, t.ballCenterGridMm)) /
+                                           dot(t.clipNormalGrid, t.axisGrid);
+                CHECK(axisAtPlane > t.baseMm + 0.5);
+                CHECK(norm(t.pointAt(axisAtPlane)) < outer - 0.5);
+                // The hull's wall-end corners lie on the plane.
+                const std::vector<Vec3d> hull = tenonHullMm(t, o);
+                for (size_t k = 4; k < 8; ++k) CHECK(std::abs(t.beyondClipMm(hull[k])) < 1e-6);
+            }
+            // Nothing of the solid outside the outer surface less 0.25 mm: sampled on a 0.5 mm
+            // grid around its end; and it is solid at the axis halfway through the wall.
+            const Vec3d e = t.pointAt(t.endMm);
+            double worst = -1e9;
+            for (double dx = -14; dx <= 14; dx += 0.5)
+                for (double dy = -14; dy <= 14; dy += 0.5)
+                    for (double dz = -14; dz <= 14; dz += 0.5) {
+                        const Vec3d q = add(e, Vec3d{dx, dy, dz});
+                        if (tenonSignedDistanceMm(t, o, q) < 0) worst = std::max(worst, norm(q) - outer);
+                    }
+            CHECK(worst < -0.25);
+            CHECK(tenonSignedDistanceMm(t, o, t.pointAt(t.baseMm + 1.0)) < 0);
+        }
+        if (outer > 50) CHECK(cut >= 1);
+        if (outer < 50) CHECK(cut == 0);
+    }
+    // With the wall the planner is told is 16 mm deep, the same ray is buried as before: no cut.
+    ShellProbe thick = sphereProbe(84.0, 100.0);
+    for (const TenonCandidate& c : findTenonCandidates(off, Transform4d::identity(), thick, o))
+        CHECK_FALSE(c.tenon.isClipped());
+}
+
 TEST_CASE("tenons: the choice keeps to each piece's direction, spreads the tenons, keeps prisms apart") {
     TenonOptions o;
     o.minPerPiece = 2;

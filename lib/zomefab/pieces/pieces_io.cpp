@@ -131,6 +131,9 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                               {"end_mm", toJson(t.pointAt(t.endMm))},
                               {"length_mm", t.lengthMm()},
                               {"tilt_deg", t.tiltDeg}});
+            if (t.isClipped())
+                tenons.back()["cut_plane"] = {{"normal", toJson(t.clipNormalGrid)},
+                                              {"offset_mm", t.clipOffsetMm}};
         }
         json pins = json::array();
         for (const AlignmentPin& pin : p.pins)

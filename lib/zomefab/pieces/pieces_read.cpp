@@ -2,6 +2,7 @@
 // pieces.json read back: the inverse of piecesToJson (pieces_io.cpp), for zf-preview, the
 // installation checks and anything else that starts from a pieces directory.
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "zomefab/core/error.h"
@@ -88,6 +89,13 @@ Tenon tenonFromJson(const json& j, uint32_t piece, const std::string& what) {
     t.baseMm = along("base_mm");
     t.endMm = along("end_mm");
     t.tiltDeg = numberFromJson(requireMember(j, "tilt_deg", what), what + ".tilt_deg");
+    if (j.contains("cut_plane")) {
+        const json& c = j.at("cut_plane");
+        const std::string where = what + ".cut_plane";
+        t.clipNormalGrid = vec3FromJson(requireMember(c, "normal", where), where + ".normal");
+        if (!(std::abs(norm(t.clipNormalGrid) - 1.0) < 1e-3)) fail(where + ".normal must be a unit vector");
+        t.clipOffsetMm = numberFromJson(requireMember(c, "offset_mm", where), where + ".offset_mm");
+    }
     return t;
 }
 

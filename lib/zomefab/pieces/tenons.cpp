@@ -39,6 +39,9 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kPrismGapMm = 0.3;
 /// Wall left between a stem's end and the outer surface, mm: two perimeters of a 0.4 mm nozzle.
 constexpr double kOuterSkinMm = 1.0;
+/// Least wall left over any point of a cut stem's end face (mm; kOuterSkinMm at the axis on a flat
+/// wall, less where the outer surface curves away from the plane).
+constexpr double kCutSkinMm = 0.3;
 /// How far the peg mesh reaches back into the prism (mm), so the two overlap.
 constexpr double kPegRootMm = 1.5;
 /// The chamfer around the peg's tip (mm, 45°): it finds the hole before the peg's full section does.
@@ -77,32 +80,115 @@ Tenon tenonAlong(const zome::Structure& frame, zome::BallId id, int hole, const 
     return t;
 }
 
+/// A point of the stem's section @p a mm along the axis, at fractions @p fl, @p fs (−1..1) of its
+/// half-width along the long and the short side.
+Vec3d sectionPoint(const Tenon& t, const TenonOptions& o, double a, double fl, double fs) {
+    const double half = stemHalfWidthMm(o, a - t.shoulderMm);
+    const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
+    return add(t.pointAt(a), add(scale(t.longSideGrid, fl * half), scale(shortSide, fs * half)));
+}
+
+/// Where the stem's line at section fractions (fl, fs) meets a cut stem's plane (bisection; the
+/// line's start is on the printed side, its end, t.endMm, past the plane).
+Vec3d cutFacePoint(const Tenon& t, const TenonOptions& o, double fl, double fs) {
+    double in = t.shoulderMm, past = t.endMm;
+    for (int k = 0; k < 30; ++k) {
+        const double mid = 0.5 * (in + past);
+        (t.beyondClipMm(sectionPoint(t, o, mid, fl, fs)) > 0 ? past : in) = mid;
+    }
+    return sectionPoint(t, o, in, fl, fs);
+}
+
+/// 5 × 5 fractions across the stem's section, corners included.
+constexpr int kLateral = 4;
+double lateralFraction(int i) { return -1.0 + 2.0 * i / kLateral; }
+
+/// For a stem a thin wall cannot bury (tenonCandidate): where the axis leaves the wall through the
+/// outer surface, the cut plane parallel to that surface kOuterSkinMm inside it, and the stem's
+/// end past the plane at every corner. False when the axis does not leave the wall within reach,
+/// leaves it too obliquely (a cut face beyond 70° of the axis would be a long sliver), or the
+/// plane leaves less than half a voxel of stem in the wall.
+bool clipThroughWall(Tenon& t, double hit, const ShellProbe& probe, const TenonOptions& o) {
+    const double step = 0.5 * probe.voxelMm;
+    const double reach = hit + 4.0 * probe.wallMm + 2.0 * probe.voxelMm;
+    double out = -1;
+    for (double s = hit + step; s <= reach; s += step)
+        if (probe.signedDistanceMm(t.pointAt(s)) >= 0) {
+            double inside = s - step, outside = s;
+            for (int i = 0; i < 24; ++i) {
+                const double m = 0.5 * (inside + outside);
+                (probe.signedDistanceMm(t.pointAt(m)) < 0 ? inside : outside) = m;
+            }
+            out = inside;
+            break;
+        }
+    if (out < 0) return false;
+    const Vec3d m = probe.normalAt(t.pointAt(out));
+    const double cosOut = dot(m, t.axisGrid);
+    if (!(cosOut > std::cos(70.0 * kPi / 180.0))) return false;
+    const double plane = out - kOuterSkinMm / cosOut;  // where the axis meets the plane
+    if (plane < hit + step) return false;
+    t.clipNormalGrid = m;
+    t.clipOffsetMm = dot(m, t.pointAt(out)) - kOuterSkinMm;
+    // Every corner of the end face beyond the plane: the corner nearest the plane trails the
+    // axis by half·(|m·l| + |m·s|)/cosOut; the half-width grows with the taper, so iterate.
+    const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
+    const double spread = std::abs(dot(m, t.longSideGrid)) + std::abs(dot(m, shortSide));
+    double end = plane;
+    for (int i = 0; i < 4; ++i) end = plane + stemHalfWidthMm(o, end - t.shoulderMm) * spread / cosOut + 0.5;
+    t.endMm = end;
+    // A curved outer surface leaves the tangent plane: move the plane in until the whole cut
+    // face keeps kCutSkinMm of wall (the corners stay past it), as long as the stem still
+    // reaches half a voxel into the wall along its axis.
+    for (int round = 0; round < 3; ++round) {
+        double worst = -1e30;
+        for (int i = 0; i <= kLateral; ++i)
+            for (int j = 0; j <= kLateral; ++j)
+                worst = std::max(worst, probe.signedDistanceMm(
+                                            cutFacePoint(t, o, lateralFraction(i), lateralFraction(j))) +
+                                            kCutSkinMm);
+        if (worst <= 0) break;
+        t.clipOffsetMm -= worst + 0.1;
+    }
+    if ((t.clipOffsetMm - dot(m, t.ballCenterGridMm)) / cosOut < hit + step) {
+        t.clipNormalGrid = {0, 0, 0};
+        return false;
+    }
+    return true;
+}
+
 /// The prism stays in its piece: wherever it is inside the shell it is this piece's, and its end
 /// face lies in this piece's wall with at least half a voxel of wall beyond. The rejection, or empty.
 std::string containment(const Tenon& t, int64_t piece, const ShellProbe& probe, const TenonOptions& o) {
     const double step = 0.5 * probe.voxelMm;
-    const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
-    const int lateral = 4;  // 5 × 5 samples across the section
     int endInWall = 0, endSamples = 0;
     bool isCentreIn = false;
-    for (int i = 0; i <= lateral; ++i)
-        for (int j = 0; j <= lateral; ++j) {
-            const double fl = -1.0 + 2.0 * i / lateral, fs = -1.0 + 2.0 * j / lateral;
-            auto at = [&](double a) {
-                const double half = stemHalfWidthMm(o, a - t.shoulderMm);
-                return add(t.pointAt(a), add(scale(t.longSideGrid, fl * half), scale(shortSide, fs * half)));
-            };
+    for (int i = 0; i <= kLateral; ++i)
+        for (int j = 0; j <= kLateral; ++j) {
+            const double fl = lateralFraction(i), fs = lateralFraction(j);
+            auto at = [&](double a) { return sectionPoint(t, o, a, fl, fs); };
             for (double a = t.shoulderMm; a <= t.endMm + 1e-9; a += step) {
                 const Vec3d q = at(a);
+                if (t.beyondClipMm(q) > 0) break;
                 if (probe.signedDistanceMm(q) < 0 && probe.pieceAt(q) != piece)
                     return "crosses another piece";
+            }
+            if (t.isClipped()) {
+                // The cut face, where this sample line meets the plane, must lie in this piece's
+                // wall with skin to spare: on a curved outer surface the plane, a tangent, would
+                // otherwise show through.
+                const Vec3d e = cutFacePoint(t, o, fl, fs);
+                if (!(probe.signedDistanceMm(e) < -kCutSkinMm && probe.pieceAt(e) == piece))
+                    return "the stem would show through a curved wall";
+                continue;
             }
             const Vec3d e = at(t.endMm);
             const bool isIn = probe.signedDistanceMm(e) < -0.5 * probe.voxelMm && probe.pieceAt(e) == piece;
             endInWall += isIn ? 1 : 0;
             ++endSamples;
-            if (i == lateral / 2 && j == lateral / 2) isCentreIn = isIn;
+            if (i == kLateral / 2 && j == kLateral / 2) isCentreIn = isIn;
         }
+    if (t.isClipped()) return "";
     // The end face bonds to the wall: its centre and most of it (a tilted thin wall may leave a
     // corner in the air, never a corner in another piece).
     return isCentreIn && 3 * endInWall >= 2 * endSamples ? "" : "too close to the piece's edge";
@@ -150,8 +236,13 @@ TenonCandidate tenonCandidate(const zome::Structure& frame, zome::BallId id, int
     const double r = std::sqrt(2.0) * stemHalfWidthMm(o, hit - t.shoulderMm);
     const double deepest =
         hit - r * tanTilt + probe.wallMm / std::cos(t.tiltDeg * kPi / 180.0) - kOuterSkinMm;
-    t.endMm = std::min(hit + o.embedMm + r * tanTilt, deepest);
-    if (t.endMm < hit + 0.5 * probe.voxelMm) return c.rejection = "surface too oblique for the wall", c;
+    t.endMm = hit + o.embedMm + r * tanTilt;
+    // A wall too thin to bury the square end: the stem goes on through it, cut parallel to the
+    // outer surface (clipThroughWall), so it bonds across the wall's whole thickness.
+    if (deepest < t.endMm && !clipThroughWall(t, hit, probe, o)) {
+        t.endMm = deepest;  // buried as deep as the wall allows, the end face partly in it
+        if (t.endMm < hit + 0.5 * probe.voxelMm) return c.rejection = "surface too oblique for the wall", c;
+    }
     const std::string obstruction = tenonObstruction(frame, t, o);
     if (!obstruction.empty())
         return c.rejection = obstruction.rfind("strut", 0) == 0 ? "strut in the way" : "ball in the way", c;
@@ -236,7 +327,8 @@ double tenonSignedDistanceMm(const Tenon& t, const TenonOptions& o, const Vec3d&
     // The frustum by the box of its section at p's depth along the axis: the zero set is exact,
     // distances off it are within 1/cos(taper) of the true ones.
     const double half = stemHalfWidthMm(o, std::clamp(a, start, t.endMm) - t.shoulderMm);
-    return boxDistance({a - bodyMid, l, s}, {bodyHalf, half, half});
+    const double prism = boxDistance({a - bodyMid, l, s}, {bodyHalf, half, half});
+    return t.isClipped() ? std::max(prism, t.beyondClipMm(p)) : prism;
 }
 
 TriMesh pegMesh(const Tenon& t, const TenonOptions& o) {
@@ -280,6 +372,11 @@ std::vector<Vec3d> tenonHullMm(const Tenon& t, const TenonOptions& o) {
     const double start = t.shoulderMm + kPrismGapMm;
     corners(start, stemHalfWidthMm(o, start - t.shoulderMm));
     corners(t.endMm, stemHalfWidthMm(o, t.endMm - t.shoulderMm));
+    if (t.isClipped())  // each side edge ends on the cut plane (every end corner lies past it)
+        for (size_t k = 4; k < 8; ++k) {
+            const double fa = t.beyondClipMm(out[k - 4]), fb = t.beyondClipMm(out[k]);
+            if (fb > 0 && fa < 0) out[k] = add(out[k - 4], scale(sub(out[k], out[k - 4]), fa / (fa - fb)));
+        }
     for (const auto& q : pegSectionMm(t.hole, o))
         out.push_back(madd(madd(t.pointAt(t.pegTipMm), q[0], t.longSideGrid), q[1], shortSide));
     return out;

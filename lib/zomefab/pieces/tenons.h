@@ -20,6 +20,7 @@
 
 #include "zomefab/core/transform.h"
 #include "zomefab/core/tri_mesh.h"
+#include "zomefab/core/vec.h"
 #include "zomefab/zome/structure.h"
 
 namespace zomefab::pieces {
@@ -96,6 +97,17 @@ struct Tenon {
     double endMm = 0.0;       ///< where the prism ends inside the wall
     double pegTipMm = 0.0;    ///< the peg's end in the hole: shoulderMm − pegDepthMm
     double tiltDeg = 0.0;     ///< angle between the axis and the inner surface's normal
+    /// A wall too thin to bury the stem's square end (a thin wall met obliquely): the stem runs
+    /// on through the wall and is cut by a plane parallel to the outer surface, a skin inside it;
+    /// points x with dot(clipNormalGrid, x) > clipOffsetMm are not printed. Zero normal: no cut.
+    Vec3d clipNormalGrid{0, 0, 0};
+    double clipOffsetMm = 0.0;
+
+    bool isClipped() const { return dot(clipNormalGrid, clipNormalGrid) > 0.0; }
+    /// How far @p p lies beyond the cut plane (mm; negative: on the printed side, or no cut).
+    double beyondClipMm(const Vec3d& p) const {
+        return isClipped() ? dot(clipNormalGrid, p) - clipOffsetMm : -1e30;
+    }
 
     double lengthMm() const { return baseMm - shoulderMm; }
     Vec3d pointAt(double t) const {
