@@ -717,6 +717,26 @@ TEST_CASE("pieces: every piece fits the bed less its margins and lies centred on
 namespace {
 
 /// A 200 × 40 × 10 mm slab as the centres of 2 mm cells (on the cells' lattice), centred at the origin.
+/// Tenon candidates along hole 0 from balls at (x, 0, 0) for each x, each a ball of its own.
+std::vector<TenonCandidate> candidatesAlongX(const std::vector<double>& xs) {
+    std::vector<TenonCandidate> list;
+    for (const double x : xs) {
+        TenonCandidate c;
+        c.score = 1.0;
+        c.tenon.ball = zome::BallId(list.size());
+        c.tenon.axisGrid = zome::holeDirection(0);
+        c.tenon.ballCenterGridMm = {x, 0.0, 0.0};
+        list.push_back(c);
+    }
+    return list;
+}
+
+std::vector<const TenonCandidate*> pointersTo(const std::vector<TenonCandidate>& list) {
+    std::vector<const TenonCandidate*> out;
+    for (const TenonCandidate& c : list) out.push_back(&c);
+    return out;
+}
+
 CoarseCells slabCells() {
     CoarseCells slab;
     slab.cellMm = 2.0;
@@ -792,6 +812,40 @@ TEST_CASE("pieces: two under-held neighbours are cut anew along a plane that hol
     CHECK(findHoldingSplits(slab, pointers(even), sweeps, search, {50, 50, 50}, 1.0, 2, 3).bothFit.empty());
 }
 
+TEST_CASE("pieces: a closed box of thin wall is cut into two cups that need no support") {
+    // A closed 100 mm cube of 4 mm wall (2 mm cells): however it lies, its ceiling hangs over the
+    // inside, 92 mm of columns under 92 × 92 mm. Cut through the middle, each half is a cup that
+    // lies on its bottom, open side up: next to no support. Candidates two on each side of x = 0.
+    CoarseCells box;
+    box.cellMm = 2.0;
+    for (int i = -25; i <= 25; ++i)
+        for (int j = -25; j <= 25; ++j)
+            for (int k = -25; k <= 25; ++k)
+                if (std::max({std::abs(i), std::abs(j), std::abs(k)}) >= 24)
+                    box.centresMm.push_back({2.0 * i, 2.0 * j, 2.0 * k});
+    const zome::Structure none;
+    const FrameSweeps sweeps(none, Transform4d::identity(), Box3d{}, 1.0, 1.0);
+    const std::vector<TenonCandidate> list = candidatesAlongX({-40.0, -30.0, 30.0, 40.0});
+    const std::vector<const TenonCandidate*> candidates = pointersTo(list);
+    SplitSearch search;
+    search.minVolumeMm3 = 1000.0;
+    const Fabrication printer = printerOf({200, 200, 200});
+    const std::optional<SupportCut> cut = supportCut(box, candidates, sweeps, search, printer, 2);
+    REQUIRE(cut.has_value());
+    CHECK(cut->beforeMm3 > 500e3);                // most of the 92 mm cube's inside
+    CHECK(cut->afterMm3 < 0.1 * cut->beforeMm3);  // the cups: a few cells' worth
+    CHECK(std::abs(cut->plane.normal[0]) > 0.99);
+    CHECK(std::abs(cut->plane.offsetMm) < 12.0);
+    // A cube of the same wall that does not close (its ceiling gone) is a cup already: no cut.
+    CoarseCells cup;
+    cup.cellMm = 2.0;
+    for (const Vec3d& x : box.centresMm)
+        if (x[2] < 42.0) cup.centresMm.push_back(x);
+    CHECK_FALSE(supportCut(cup, candidates, sweeps, search, printer, 2).has_value());
+    // A printer too small for the halves: no cut that fits.
+    CHECK_FALSE(supportCut(box, candidates, sweeps, search, printerOf({60, 60, 60}), 2).has_value());
+}
+
 TEST_CASE("pieces: a union no plane cuts into two held pieces that fit is cut into three") {
     // The slab of the case above (200 × 40 × 10 mm) and an 80 mm printer: no half of a plane through
     // the slab fits with the other (one of them is at least 100 mm long), but three parts of about
@@ -800,17 +854,8 @@ TEST_CASE("pieces: a union no plane cuts into two held pieces that fit is cut in
     const CoarseCells slab = slabCells();
     const zome::Structure none;
     const FrameSweeps sweeps(none, Transform4d::identity(), Box3d{}, 1.0, 1.0);
-    std::vector<TenonCandidate> list;
-    for (const double x : {-90.0, -80.0, -10.0, 10.0, 80.0, 90.0}) {
-        TenonCandidate c;
-        c.score = 1.0;
-        c.tenon.ball = zome::BallId(list.size());
-        c.tenon.axisGrid = zome::holeDirection(0);
-        c.tenon.ballCenterGridMm = {x, 0.0, 0.0};
-        list.push_back(c);
-    }
-    std::vector<const TenonCandidate*> candidates;
-    for (const TenonCandidate& c : list) candidates.push_back(&c);
+    const std::vector<TenonCandidate> list = candidatesAlongX({-90.0, -80.0, -10.0, 10.0, 80.0, 90.0});
+    const std::vector<const TenonCandidate*> candidates = pointersTo(list);
     SplitSearch search;
     search.voxelMm = slab.cellMm;
     search.minVolumeMm3 = 1000.0;

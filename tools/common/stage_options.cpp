@@ -259,6 +259,10 @@ void PiecesCli::addTo(CLI::App& app) {
     app.add_flag("--recut-pairs", o.isRecuttingPairs,
                  "Cut a piece fewer than --min-tenons pegs hold anew with a neighbour so both are held "
                  "(more pegs, more support to print)");
+    app.add_flag(
+        "--cut-for-support", o.isCuttingForSupport,
+        "Cut a held piece that needs much support however it lies in two, where both halves stay held "
+        "and need much less support");
     app.add_flag("--no-glue-groups", isNotGluing,
                  "Do not glue a piece fewer than --min-tenons pegs hold to a neighbour before mounting, nor print "
                  "pieces glued together as one");

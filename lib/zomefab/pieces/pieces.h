@@ -79,6 +79,10 @@ struct PiecesOptions {
     /// minPerPiece pegs (docs/mounting.md, "Pairs cut anew"). Off by default: the halves print
     /// with more support (the demo: 12 of 12 pieces on two pegs instead of 10, 6 h more to print).
     bool isRecuttingPairs = false;
+    /// Cut a held piece that needs much support however it lies (a cup of thin wall, a head with
+    /// its ears) in two along a plane that holds both halves, where they need much less support
+    /// (docs/pieces.md, "Cut for less support").
+    bool isCuttingForSupport = false;
     /// Glue a piece (or glued group) too few pegs hold to a neighbour before mounting, where the two
     /// go on as one body along a direction whose tenons hold both (docs/mounting.md, "Glued
     /// groups"). Nothing more to print but alignment pins; the maker glues a few pairs more.
@@ -158,6 +162,8 @@ struct Pieces {
     size_t mergedPieces = 0;  ///< under-held pieces printed as one with a neighbour (docs/mounting.md)
     /// Pairs of neighbours cut anew along another plane so that both are held (docs/mounting.md).
     size_t recutPairs = 0;
+    /// Held pieces cut in two for less support (PiecesOptions::isCuttingForSupport).
+    size_t supportCuts = 0;
     /// Pairs glued before mounting because one of them was held by too few pegs (docs/mounting.md).
     size_t gluedForPegs = 0;
     /// The frame with the struts grown toward pieces too few pegs hold (PiecesOptions::

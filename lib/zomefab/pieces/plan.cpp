@@ -299,6 +299,7 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         out.frameStrutsGrown += growFrameForPieces(replanner, canGrow);
     mergeUnderHeld(replanner, fabrication);
     if (opt.isRecuttingPairs) recutUnderHeldPairs(replanner, fabrication);
+    if (opt.isCuttingForSupport) cutForSupport(replanner, fabrication);
     // Last: glued groups are pairs of piece numbers, which merges and cuts would change.
     if (opt.isGluingUnderHeld) {
         glueUnderHeld(replanner);

@@ -189,6 +189,34 @@ std::vector<PairCut> pairCuts(const CoarseCells& cells, const std::vector<const 
 /// cut anew".
 void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication);
 
+/// The least support a solid of @p cells (cubes of side @p cellMm) needs, resting at its lowest
+/// cell, over 64 directions spread over the sphere and @p ups along which it fits @p boxMm (the
+/// height, and the footprint turned about the vertical in 5° steps on the bed): restingSupportMm3,
+/// mm³ of solid columns; infinite when it fits none (support_cuts.cpp).
+double leastSupportMm3(const std::vector<Vec3d>& cells, double cellMm, const std::vector<Vec3d>& ups,
+                       const Vec3d& boxMm);
+
+/// A plane that cuts a piece into two halves that need much less support than the piece.
+struct SupportCut {
+    SplitPlane plane;
+    double beforeMm3 = 0.0;  ///< the piece's least support (leastSupportMm3 on 4 mm cells)
+    double afterMm3 = 0.0;   ///< its halves', each also lying on the new cut face or with it up
+};
+/// For a piece (@p cells: its coarse cells; @p candidates: its usable tenon candidates) whose least
+/// support is at least half its volume and 30 cm³: of findHoldingSplits's planes that hold both
+/// halves with @p minPegs and fit the printer, the one whose halves need the least support, when
+/// they need at most 60 % of the piece's and 30 cm³ less. Empty otherwise.
+std::optional<SupportCut> supportCut(const CoarseCells& cells,
+                                     const std::vector<const TenonCandidate*>& candidates,
+                                     const FrameSweeps& sweeps, SplitSearch search,
+                                     const Fabrication& fabrication, size_t minPegs);
+
+/// Held pieces that need much support however they lie are cut in two along supportCut's plane,
+/// the one that saves the most first, and the plan made again; kept when more pieces are held and
+/// none more under-held (Change::kMorePieces). At most 6 plans. docs/pieces.md, "Cut for less
+/// support". PiecesOptions::isCuttingForSupport.
+void cutForSupport(Replanner& r, const Fabrication& fabrication);
+
 /// Steps (pieces or glued groups) fewer than minPerPiece pegs hold, a piece glued on as it goes on
 /// among them, are glued to a neighbouring step before mounting, so the two go on as one body
 /// along a direction whose tenons hold both (docs/mounting.md, "Glued groups"); kept when fewer
