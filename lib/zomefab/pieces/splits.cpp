@@ -44,12 +44,6 @@ std::vector<Vec3d> splitDirections() {
     return out;
 }
 
-/// A cell index (i, j, k) packed into one key (21 bits each, wrapping: the grids here span far
-/// fewer than 2^21 cells).
-int64_t packCell(int64_t i, int64_t j, int64_t k) {
-    return ((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF);
-}
-
 /// The piece's voxels with their 6-neighbours (indices, kNone where the neighbour is not in it).
 struct VoxelGraph {
     const std::vector<Vec3d>* voxels = nullptr;

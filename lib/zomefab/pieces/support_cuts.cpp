@@ -42,8 +42,7 @@ std::vector<Vec3d> binned(const std::vector<Vec3d>& cells, double binMm) {
     for (const Vec3d& x : cells) {
         const int64_t i = int64_t(std::floor(x[0] / binMm)), j = int64_t(std::floor(x[1] / binMm)),
                       k = int64_t(std::floor(x[2] / binMm));
-        const int64_t key = ((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF);
-        if (seen.insert(key).second)
+        if (seen.insert(packCell(i, j, k)).second)
             out.push_back({(double(i) + 0.5) * binMm, (double(j) + 0.5) * binMm, (double(k) + 0.5) * binMm});
     }
     return out;

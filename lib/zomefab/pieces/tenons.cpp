@@ -112,24 +112,23 @@ bool clipThroughWall(Tenon& t, double hit, const ShellProbe& probe, const TenonO
     const double step = 0.5 * probe.voxelMm;
     const double reach = hit + 4.0 * probe.wallMm + 2.0 * probe.voxelMm;
     double out = -1;
-    for (double s = hit + step; s <= reach; s += step)
-        if (probe.signedDistanceMm(t.pointAt(s)) >= 0) {
-            double inside = s - step, outside = s;
-            for (int i = 0; i < 24; ++i) {
-                const double m = 0.5 * (inside + outside);
-                (probe.signedDistanceMm(t.pointAt(m)) < 0 ? inside : outside) = m;
-            }
-            out = inside;
-            break;
-        }
+    for (double s = hit + step; s <= reach && out < 0; s += step)
+        if (probe.signedDistanceMm(t.pointAt(s)) >= 0)
+            out = bisect(probe, t.ballCenterGridMm, t.axisGrid, s, s - step);
     if (out < 0) return false;
     const Vec3d m = probe.normalAt(t.pointAt(out));
     const double cosOut = dot(m, t.axisGrid);
     if (!(cosOut > std::cos(70.0 * kPi / 180.0))) return false;
-    const double plane = out - kOuterSkinMm / cosOut;  // where the axis meets the plane
-    if (plane < hit + step) return false;
     t.clipNormalGrid = m;
     t.clipOffsetMm = dot(m, t.pointAt(out)) - kOuterSkinMm;
+    // The stem must still reach half a voxel into the wall along its axis.
+    auto isInWall = [&] {
+        if (t.clipAlongAxisMm() >= hit + step) return true;
+        t.clipNormalGrid = {0, 0, 0};
+        return false;
+    };
+    if (!isInWall()) return false;
+    const double plane = t.clipAlongAxisMm();
     // Every corner of the end face beyond the plane: the corner nearest the plane trails the
     // axis by half·(|m·l| + |m·s|)/cosOut; the half-width grows with the taper, so iterate.
     const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
@@ -139,7 +138,7 @@ bool clipThroughWall(Tenon& t, double hit, const ShellProbe& probe, const TenonO
     t.endMm = end;
     // A curved outer surface leaves the tangent plane: move the plane in until the whole cut
     // face keeps kCutSkinMm of wall (the corners stay past it), as long as the stem still
-    // reaches half a voxel into the wall along its axis.
+    // reaches into the wall.
     for (int round = 0; round < 3; ++round) {
         double worst = -1e30;
         for (int i = 0; i <= kLateral; ++i)
@@ -150,11 +149,7 @@ bool clipThroughWall(Tenon& t, double hit, const ShellProbe& probe, const TenonO
         if (worst <= 0) break;
         t.clipOffsetMm -= worst + 0.1;
     }
-    if ((t.clipOffsetMm - dot(m, t.ballCenterGridMm)) / cosOut < hit + step) {
-        t.clipNormalGrid = {0, 0, 0};
-        return false;
-    }
-    return true;
+    return isInWall();
 }
 
 /// The prism stays in its piece: wherever it is inside the shell it is this piece's, and its end

@@ -108,6 +108,10 @@ struct Tenon {
     double beyondClipMm(const Vec3d& p) const {
         return isClipped() ? dot(clipNormalGrid, p) - clipOffsetMm : -1e30;
     }
+    /// Where the axis meets the cut plane, mm from the ball's centre (a cut tenon only).
+    double clipAlongAxisMm() const {
+        return (clipOffsetMm - dot(clipNormalGrid, ballCenterGridMm)) / dot(clipNormalGrid, axisGrid);
+    }
 
     double lengthMm() const { return baseMm - shoulderMm; }
     Vec3d pointAt(double t) const {

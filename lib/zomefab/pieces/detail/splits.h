@@ -7,6 +7,7 @@
 /// halves see the same plane. docs/mounting.md, "Re-cut pieces".
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -16,6 +17,12 @@
 #include "zomefab/pieces/detail/voxels.h"
 
 namespace zomefab::pieces::detail {
+
+/// A cell index (i, j, k) packed into one key (21 bits each, wrapping: the grids here span far
+/// fewer than 2^21 cells).
+inline int64_t packCell(int64_t i, int64_t j, int64_t k) {
+    return ((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF);
+}
 
 /// A cut plane: the part with normal·x > offsetMm becomes the new piece (grid mm).
 struct SplitPlane {
