@@ -154,3 +154,21 @@ TEST_CASE("staged directory: refuses to replace a directory that is not a zomefa
     for (const auto& e : fs::directory_iterator(dir.path())) entries += e.is_directory() ? 1 : 0;
     CHECK(entries == 2);
 }
+
+TEST_CASE("pipeline: the partition runs again for smaller pieces only while that can help") {
+    using pipeline::shouldPartitionAgain;
+    // The first plan with no order always gets a run again, whatever its count.
+    CHECK(shouldPartitionAgain(0, 0, 1));
+    CHECK(shouldPartitionAgain(0, 0, 400));
+    // A few problems more come and go with the cuts (the armadillo at 600 mm needs the third run).
+    CHECK(shouldPartitionAgain(1, 2, 2));
+    CHECK(shouldPartitionAgain(1, 2, 6));
+    CHECK(shouldPartitionAgain(1, 16, 23));
+    // A clear rise ends it: the cheese at 700 mm went from 16 to 26 problems.
+    CHECK_FALSE(shouldPartitionAgain(1, 2, 7));
+    CHECK_FALSE(shouldPartitionAgain(1, 16, 26));
+    CHECK_FALSE(shouldPartitionAgain(1, 100, 150));
+    CHECK(shouldPartitionAgain(1, 100, 149));
+    // Never more than kMaxReplans runs again.
+    CHECK_FALSE(shouldPartitionAgain(pipeline::kMaxReplans, 10, 1));
+}

@@ -191,7 +191,13 @@ public:
 /// What requireBuildable throws: the installation plan has problems (exit 3).
 class NotBuildable : public Error {
 public:
-    explicit NotBuildable(const std::string& message) : Error(ErrorCode::ProcessingFailed, message) {}
+    explicit NotBuildable(const std::string& message, size_t problemCount = 1)
+        : Error(ErrorCode::ProcessingFailed, message), mProblemCount(problemCount) {}
+    /// How many problems the plan recorded (a piece no direction mounts, a group stuck in a cycle).
+    size_t problemCount() const { return mProblemCount; }
+
+private:
+    size_t mProblemCount;
 };
 
 /// @throw NotBuildable "the pieces cannot be put on the frame: ..." naming the plan's problems,

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "zomefab/pipeline/pipeline.h"
 
+#include <algorithm>
+
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
 #include "zomefab/core/version.h"
@@ -117,10 +119,11 @@ void makePieces(report::RunRecord& run, const RunOptions& options, RunContext& c
 
 /// How often the partition runs again for a piece that came out too large.
 constexpr int kMaxRefits = 3;
-/// How often the partition runs again, for smaller pieces, when its pieces have no mounting order.
-constexpr int kMaxReplans = 2;
 /// By how much each of those runs grows the fit margin (mm; each side of a region's box).
 constexpr double kReplanMarginStepMm = 3.0;
+/// A run again that leaves at least this many problems more than the plan before it (and half as
+/// many again) is the last (shouldPartitionAgain).
+constexpr size_t kReplanProblemRise = 5;
 /// The largest tenon tilt of those runs (degrees; pieces::TenonOptions::maxTiltDeg, default 60).
 constexpr double kReplanTiltDeg = 35.0;
 
@@ -139,6 +142,7 @@ constexpr double kReplanTiltDeg = 35.0;
 void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunContext& context,
                      const sdf::InteriorField& interior) {
     int refits = 0, replans = 0;
+    size_t problemsBefore = 0;     // of the last plan with no order, before the latest run again
     RunOptions attempt = options;  // the tenon tilt narrows on a replan; pieces.json records it
     for (;;) {
         partitionSurface(run, options, context);
@@ -150,12 +154,27 @@ void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunConte
             // say that this, not the plan, is why.
             if (run.frame.lattice.cubes == 0)
                 throw pieces::NotBuildable(e.message() + " (the object is thinner than one B0 cube and its " +
-                                           formatNumbers("%.0f", run.fabrication.frameDMinMm()) +
-                                           " mm clearance, so its frame is only " +
-                                           std::to_string(run.frame.structure.ballCount()) + " balls and " +
-                                           std::to_string(run.frame.structure.strutCount()) +
-                                           " struts: too few to hold every piece)");
-            if (++replans > kMaxReplans) throw;
+                                               formatNumbers("%.0f", run.fabrication.frameDMinMm()) +
+                                               " mm clearance, so its frame is only " +
+                                               std::to_string(run.frame.structure.ballCount()) +
+                                               " balls and " +
+                                               std::to_string(run.frame.structure.strutCount()) +
+                                               " struts: too few to hold every piece)",
+                                           e.problemCount());
+            if (!shouldPartitionAgain(replans, problemsBefore, e.problemCount())) {
+                if (replans >= kMaxReplans) throw;
+                throw pieces::NotBuildable(
+                    e.message() +
+                        formatNumbers(
+                            " (partitioning again for smaller pieces, with a fit margin of %.1f mm, "
+                            "left many more problems than before, ",
+                            run.fabrication.fitMarginMm) +
+                        std::to_string(e.problemCount()) + " against " + std::to_string(problemsBefore) +
+                        ": smaller pieces do not free these)",
+                    e.problemCount());
+            }
+            ++replans;
+            problemsBefore = e.problemCount();
             const double before = run.fabrication.fitMarginMm;
             run.fabrication.fitMarginMm = before + kReplanMarginStepMm;
             double& tiltDeg = attempt.pieces.tenons.maxTiltDeg;
@@ -195,6 +214,14 @@ void reportRun(report::RunRecord& run, const RunOptions& options, RunContext& co
 }
 
 }  // namespace
+
+bool shouldPartitionAgain(int replansDone, size_t problemsBefore, size_t problemsNow) {
+    if (replansDone >= kMaxReplans) return false;
+    // A few problems more or less come and go with the cuts (the armadillo at 600 mm: 2, then 2,
+    // then none); only a clear rise says smaller pieces are not the cure.
+    const size_t rise = std::max<size_t>(kReplanProblemRise, problemsBefore / 2);
+    return replansDone == 0 || problemsNow < problemsBefore + rise;
+}
 
 void checkRunOptions(const RunOptions& options) {
     checkFabrication(options.fabrication);

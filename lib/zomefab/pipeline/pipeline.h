@@ -36,6 +36,19 @@ struct RunOptions {
     report::PreviewOptions preview;         ///< preview.glb: Draco settings
 };
 
+/// How often the partition runs again, for smaller pieces, when its pieces have no mounting order.
+inline constexpr int kMaxReplans = 2;
+
+/// Whether `zomefab run` partitions again, for smaller pieces, after a plan with no mounting order
+/// that recorded @p problemsNow problems, when @p replansDone runs again came before it and the
+/// plan that started the last of them recorded @p problemsBefore: at most kMaxReplans times, and
+/// not when the last run again left clearly more problems than the plan before it (5 more, and
+/// half as many again). Smaller pieces free pieces that interlock; pieces the
+/// frame blocks along every straight path (the cheese's tunnel linings) they do not: at 700 mm the
+/// cheese went from 16 to 26 problems at the first run again, each run taking about 20 minutes
+/// (docs/benchmarks.md).
+bool shouldPartitionAgain(int replansDone, size_t problemsBefore, size_t problemsNow);
+
 /// @throw Error(Usage) for inconsistent options, before any work (tools call it before reading).
 void checkRunOptions(const RunOptions& options);
 
