@@ -18,81 +18,6 @@ using namespace detail;
 
 namespace {
 
-/// Convex hull (Andrew's monotone chain) of 2D points, counter-clockwise.
-std::vector<std::array<double, 2>> convexHull(std::vector<std::array<double, 2>> p) {
-    std::sort(p.begin(), p.end());
-    p.erase(std::unique(p.begin(), p.end()), p.end());
-    if (p.size() < 3) return p;
-    std::vector<std::array<double, 2>> h(2 * p.size());
-    auto turn = [](const std::array<double, 2>& o, const std::array<double, 2>& a,
-                   const std::array<double, 2>& b) {
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
-    };
-    size_t k = 0;
-    for (size_t i = 0; i < p.size(); ++i) {
-        while (k >= 2 && turn(h[k - 2], h[k - 1], p[i]) <= 0) --k;
-        h[k++] = p[i];
-    }
-    for (size_t i = p.size() - 1, t = k + 1; i > 0; --i) {
-        while (k >= t && turn(h[k - 2], h[k - 1], p[i - 1]) <= 0) --k;
-        h[k++] = p[i - 1];
-    }
-    h.resize(k - 1);
-    return h;
-}
-
-struct Placement {
-    double ratio = 1e30;  ///< max(ex/Px, ey/Py, ez/Pz)
-    double angleRad = 0;
-};
-
-/// The best turn about the vertical of points already rotated so that "down" is −z.
-Placement bestTurn(const std::vector<std::array<double, 2>>& hull, double heightMm, const Vec3d& printer) {
-    auto ratioAt = [&](double angle) {
-        const double c = std::cos(angle), s = std::sin(angle);
-        double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
-        for (const auto& q : hull) {
-            const double x = c * q[0] - s * q[1], y = s * q[0] + c * q[1];
-            x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
-        }
-        return std::max({(x1 - x0) / printer[0], (y1 - y0) / printer[1], heightMm / printer[2]});
-    };
-    Placement best;
-    // 1° steps over a half turn (a half turn maps the box onto itself), then 0.05° around the best.
-    for (int i = 0; i < 180; ++i) {
-        const double a = i * kPi / 180.0;
-        const double r = ratioAt(a);
-        if (r < best.ratio - 1e-12) best = {r, a};
-    }
-    const double centre = best.angleRad;
-    for (int i = -20; i <= 20; ++i) {
-        const double a = centre + i * 0.05 * kPi / 180.0;
-        const double r = ratioAt(a);
-        if (r < best.ratio - 1e-12) best = {r, a};
-    }
-    return best;
-}
-
-struct Candidate {
-    Placement placement;
-    std::array<Vec3d, 3> rows{};
-};
-
-Candidate evaluate(const std::vector<Vec3d>& points, const Vec3d& down, const Vec3d& printer) {
-    Candidate c;
-    c.rows = rotationDown(down);
-    std::vector<std::array<double, 2>> projected;
-    projected.reserve(points.size());
-    double z0 = 1e300, z1 = -1e300;
-    for (const Vec3d& p : points) {
-        projected.push_back({dot(c.rows[0], p), dot(c.rows[1], p)});
-        const double z = dot(c.rows[2], p);
-        z0 = std::min(z0, z), z1 = std::max(z1, z);
-    }
-    c.placement = bestTurn(convexHull(std::move(projected)), z1 - z0, printer);
-    return c;
-}
-
 /// The part of a triangle (corners @p v, heights @p z along "up") at or below @p top: a convex
 /// polygon of up to 4 corners, in order, with their heights. Returns the number of corners.
 int clipBelow(const Vec3d* const v[3], const double z[3], double top, Vec3d corner[4], double height[4]) {
@@ -245,7 +170,7 @@ public:
         for (const Vec3d& d : sphereDirections()) directions.push_back(d);
     }
 
-    bool fits(const Vec3d& d) const { return evaluate(mesh.points, d, printer).placement.ratio <= 1.0; }
+    bool fits(const Vec3d& d) const { return fitsOnBed(mesh.points, d, printer); }
     double firstLayerMm2(const Vec3d& d) const { return sectionArea(mesh, d, kBaseHeightMm); }
     bool hasFirstLayer(const Vec3d& d) const { return firstLayerMm2(d) >= kMinBaseMm2; }
     /// Support volume plus what a first layer of @p baseMm2 costs below a brim's worth
@@ -343,7 +268,7 @@ public:
         Vec3d down = tried[0];
         double ratio = 1e300;
         for (const Vec3d& d : tried) {
-            const double r = evaluate(mesh.points, d, printer).placement.ratio;
+            const double r = placeOnBed(mesh.points, d, printer).ratio;
             if (r < ratio - 1e-12) ratio = r, down = d;
         }
         return down;
@@ -386,8 +311,8 @@ public:
 /// Fills @p out's transform, extents and fit for the piece resting on @p out.downNormal: turned
 /// about z for the most room, on the bed (z = 0), centred in x and y.
 void place(const MeshD& mesh, const Vec3d& printer, PrintOrientation& out) {
-    const Candidate chosen = evaluate(mesh.points, out.downNormal, printer);
-    const double ca = std::cos(chosen.placement.angleRad), sa = std::sin(chosen.placement.angleRad);
+    const BedPlacement chosen = placeOnBed(mesh.points, out.downNormal, printer);
+    const double ca = std::cos(chosen.angleRad), sa = std::sin(chosen.angleRad);
     const Vec3d r0 = sub(scale(chosen.rows[0], ca), scale(chosen.rows[1], sa));
     const Vec3d r1 = add(scale(chosen.rows[0], sa), scale(chosen.rows[1], ca));
     const Vec3d& r2 = chosen.rows[2];

@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The support a piece would need in an orientation (orientation.h, estimateSupport).
+// The support a piece would need in an orientation (orientation.h, estimateSupport), and how it
+// lies on the bed in one (placeOnBed).
 #include "zomefab/pieces/detail/support.h"
 
 #include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 namespace zomefab::pieces {
 
@@ -34,6 +36,99 @@ std::array<Vec3d, 3> rotationDown(const Vec3d& down) {
     const Vec3d x = normalized(cross(helper, z));
     const Vec3d y = cross(z, x);
     return {x, y, z};
+}
+
+namespace {
+
+/// Convex hull (Andrew's monotone chain) of 2D points, counter-clockwise.
+std::vector<std::array<double, 2>> convexHull(std::vector<std::array<double, 2>> p) {
+    std::sort(p.begin(), p.end());
+    p.erase(std::unique(p.begin(), p.end()), p.end());
+    if (p.size() < 3) return p;
+    std::vector<std::array<double, 2>> h(2 * p.size());
+    auto turn = [](const std::array<double, 2>& o, const std::array<double, 2>& a,
+                   const std::array<double, 2>& b) {
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+    };
+    size_t k = 0;
+    for (size_t i = 0; i < p.size(); ++i) {
+        while (k >= 2 && turn(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+        h[k++] = p[i];
+    }
+    for (size_t i = p.size() - 1, t = k + 1; i > 0; --i) {
+        while (k >= t && turn(h[k - 2], h[k - 1], p[i - 1]) <= 0) --k;
+        h[k++] = p[i - 1];
+    }
+    h.resize(k - 1);
+    return h;
+}
+
+/// The best turn about the vertical of points already rotated so that "down" is −z; with
+/// @p isFitEnough, the first turn that fits (ratio ≤ 1) instead.
+BedPlacement bestTurn(const std::vector<std::array<double, 2>>& hull, double heightMm, const Vec3d& printer,
+                      bool isFitEnough) {
+    auto ratioAt = [&](double angle) {
+        const double c = std::cos(angle), s = std::sin(angle);
+        double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+        for (const auto& q : hull) {
+            const double x = c * q[0] - s * q[1], y = s * q[0] + c * q[1];
+            x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+        }
+        return std::max({(x1 - x0) / printer[0], (y1 - y0) / printer[1], heightMm / printer[2]});
+    };
+    BedPlacement best;
+    auto consider = [&](double a) {
+        const double r = ratioAt(a);
+        if (r < best.ratio - 1e-12) best.ratio = r, best.angleRad = a;
+        return isFitEnough && best.ratio <= 1.0;
+    };
+    // 1° steps over a half turn (a half turn maps the box onto itself), then 0.05° around the best.
+    for (int i = 0; i < 180; ++i)
+        if (consider(i * kPi / 180.0)) return best;
+    const double centre = best.angleRad;
+    for (int i = -20; i <= 20; ++i)
+        if (consider(centre + i * 0.05 * kPi / 180.0)) return best;
+    return best;
+}
+
+/// @p points seen with @p down down: rotationDown's rows, the convex hull of their footprint on
+/// the bed, and their height.
+struct Lying {
+    std::array<Vec3d, 3> rows{};
+    std::vector<std::array<double, 2>> hull;
+    double heightMm = 0;
+};
+
+Lying lying(const std::vector<Vec3d>& points, const Vec3d& down) {
+    Lying out;
+    out.rows = rotationDown(down);
+    std::vector<std::array<double, 2>> projected;
+    projected.reserve(points.size());
+    double z0 = 1e300, z1 = -1e300;
+    for (const Vec3d& p : points) {
+        projected.push_back({dot(out.rows[0], p), dot(out.rows[1], p)});
+        const double z = dot(out.rows[2], p);
+        z0 = std::min(z0, z), z1 = std::max(z1, z);
+    }
+    out.hull = convexHull(std::move(projected));
+    out.heightMm = z1 - z0;
+    return out;
+}
+
+}  // namespace
+
+BedPlacement placeOnBed(const std::vector<Vec3d>& points, const Vec3d& down, const Vec3d& printerMm) {
+    const Lying l = lying(points, down);
+    BedPlacement placement = bestTurn(l.hull, l.heightMm, printerMm, false);
+    placement.rows = l.rows;
+    return placement;
+}
+
+bool fitsOnBed(const std::vector<Vec3d>& points, const Vec3d& down, const Vec3d& printerMm) {
+    const Lying l = lying(points, down);
+    // The ratio is at least the height's share at every turn.
+    if (l.heightMm > printerMm[2]) return false;
+    return bestTurn(l.hull, l.heightMm, printerMm, true).ratio <= 1.0;
 }
 
 /// The smallest coordinate of the mesh's points along @p up, mm.

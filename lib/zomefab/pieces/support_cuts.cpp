@@ -48,35 +48,6 @@ std::vector<Vec3d> binned(const std::vector<Vec3d>& cells, double binMm) {
     return out;
 }
 
-/// Whether @p cells lying with @p up up fit @p boxMm (x, y the bed, z the height): the height, and
-/// the footprint turned about the vertical in 5° steps.
-bool fitsLying(const std::vector<Vec3d>& cells, const Vec3d& up, const Vec3d& boxMm) {
-    const std::array<Vec3d, 3> rows = rotationDown(scale(up, -1.0));  // rows[2] = up
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    std::vector<std::array<double, 2>> footprint;
-    footprint.reserve(cells.size());
-    for (const Vec3d& x : cells) {
-        const double h = dot(rows[2], x);
-        lo = std::min(lo, h), hi = std::max(hi, h);
-        footprint.push_back({dot(rows[0], x), dot(rows[1], x)});
-    }
-    // The cells' centres: a cell reaches past the solid it samples by up to half its side, so
-    // their extent is about the solid's (a thin wall binned to 4 mm cells would seem 4 mm wider).
-    if (hi - lo > boxMm[2]) return false;
-    const double bedLong = std::max(boxMm[0], boxMm[1]), bedShort = std::min(boxMm[0], boxMm[1]);
-    for (int k = 0; k < 18; ++k) {
-        const double a = k * 5.0 * kPi / 180.0, c = std::cos(a), s = std::sin(a);
-        double u0 = std::numeric_limits<double>::infinity(), u1 = -u0, v0 = u0, v1 = -u0;
-        for (const auto& q : footprint) {
-            const double u = c * q[0] + s * q[1], v = -s * q[0] + c * q[1];
-            u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
-        }
-        const double e1 = u1 - u0, e2 = v1 - v0;
-        if (std::max(e1, e2) <= bedLong && std::min(e1, e2) <= bedShort) return true;
-    }
-    return false;
-}
-
 }  // namespace
 
 double leastSupportMm3(const std::vector<Vec3d>& cells, double cellMm, const std::vector<Vec3d>& ups,
@@ -86,7 +57,9 @@ double leastSupportMm3(const std::vector<Vec3d>& cells, double cellMm, const std
     directions.insert(directions.end(), ups.begin(), ups.end());
     double best = std::numeric_limits<double>::infinity();
     for (const Vec3d& up : directions) {
-        if (!fitsLying(cells, up, boxMm)) continue;
+        // The cells' centres: a cell reaches past the solid it samples by up to half its side, so
+        // their extent is about the solid's (a thin wall binned to 4 mm cells would seem 4 mm wider).
+        if (!fitsOnBed(cells, scale(up, -1.0), boxMm)) continue;
         double lowest = std::numeric_limits<double>::infinity();
         for (const Vec3d& x : cells) lowest = std::min(lowest, dot(up, x));
         best = std::min(best, restingSupportMm3(cells, up, lowest - 0.5 * cellMm, cellMm));

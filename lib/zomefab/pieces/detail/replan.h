@@ -190,9 +190,9 @@ std::vector<PairCut> pairCuts(const CoarseCells& cells, const std::vector<const 
 void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication);
 
 /// The least support a solid of @p cells (cubes of side @p cellMm) needs, resting at its lowest
-/// cell, over 64 directions spread over the sphere and @p ups along which it fits @p boxMm (the
-/// height, and the footprint turned about the vertical in 5° steps on the bed): restingSupportMm3,
-/// mm³ of solid columns; infinite when it fits none (support_cuts.cpp).
+/// cell, over 256 directions spread over the sphere and @p ups along which it fits @p boxMm
+/// (placeOnBed): restingSupportMm3, mm³ of solid columns; infinite when it fits none
+/// (support_cuts.cpp).
 double leastSupportMm3(const std::vector<Vec3d>& cells, double cellMm, const std::vector<Vec3d>& ups,
                        const Vec3d& boxMm);
 

@@ -37,6 +37,23 @@ std::vector<Vec3d> fibonacciSphere(int count);
 /// Rows of a rotation taking @p down (unit) to (0, 0, −1): x, y in the bed's plane, z up.
 std::array<Vec3d, 3> rotationDown(const Vec3d& down);
 
+/// How points lie on a printer with a given direction down, turned about the vertical for the
+/// best fit.
+struct BedPlacement {
+    std::array<Vec3d, 3> rows{};  ///< rotationDown(down): x, y on the bed, z up (before the turn)
+    double ratio = 1e30;          ///< max(ex/Px, ey/Py, ez/Pz) at the best turn: ≤ 1 fits
+    double angleRad = 0;          ///< that turn about the vertical
+};
+
+/// @p points lying with @p down (unit) down on a printer of @p printerMm (x, y the bed, z the
+/// height), at the turn about the vertical that fits best: 1° steps over a half turn of their
+/// convex footprint, then 0.05° about the best. The one "fits lying this way" test of the pieces
+/// (orientation.cpp, support_cuts.cpp).
+BedPlacement placeOnBed(const std::vector<Vec3d>& points, const Vec3d& down, const Vec3d& printerMm);
+
+/// placeOnBed(@p points, @p down, @p printerMm).ratio ≤ 1, answered at the first turn that fits.
+bool fitsOnBed(const std::vector<Vec3d>& points, const Vec3d& down, const Vec3d& printerMm);
+
 /// The smallest coordinate of the mesh's points along @p up, mm.
 double lowestAlong(const MeshD& m, const Vec3d& up);
 
