@@ -11,6 +11,7 @@
 
 #include "zomefab/core/format.h"
 #include "zomefab/core/run_context.h"
+#include "zomefab/pieces/detail/keystone.h"
 #include "zomefab/pieces/detail/merges.h"
 #include "zomefab/pieces/detail/mounting.h"
 #include "zomefab/pieces/detail/pins.h"
@@ -47,6 +48,9 @@ void warnShortfall(const Pieces& out, const TenonOptions& o, const RunContext& c
 }
 
 constexpr int kRecutRounds = 5;  ///< plan, re-cut the blocked pieces, plan again: at most this often
+/// Keystones cut after the re-cuts, each followed by a plan: a ring around a hole needs one, a few
+/// rings a few.
+constexpr int kKeystoneRounds = 3;
 
 /// The box every piece's voxels and every ball lie in (grid mm): the frame sweeps' rectangle.
 Box3d planBounds(const VoxelField& field, const zome::Structure& frame, const Transform4d& frameToGridMm) {
@@ -100,6 +104,63 @@ size_t recutBlocked(Pieces& out, VoxelField& field, const GridCells& cells, Grou
     out.recutPieces += cut;
     if (cut > 0) grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
     return cut;
+}
+
+/// Cuts a keystone out of one piece that is free of the frame alone but placed nowhere (the
+/// largest for which findKeystone finds one): the wedges along the faces that block it become
+/// pieces of their own. Returns how many pieces were added (0: none found).
+size_t cutKeystone(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
+                   const PlannerInput& input, const std::vector<TenonCandidate>& candidates,
+                   const FrameSweeps& sweeps, const PiecesOptions& opt, const RunContext& context) {
+    const SplitSearch search = splitSearchFor(field, opt);
+    // The pieces stuck before any gluing: the plan's glued groups hide which piece the ring turns on.
+    PlannerInput unglued = input;
+    unglued.isGluingStuck = false;
+    const mount::InstallationPlan plan =
+        planMounting(unglued, sweeps, grouping.faces, field.voxelMm, tenonHoleSet(opt.tenons.holes),
+                     opt.tenons.maxPerPiece, context);
+    std::vector<std::pair<double, uint32_t>> stuck;  // (−volume, piece)
+    for (uint32_t p = 0; p < out.pieces.size(); ++p)
+        if (plan.holeOfPiece[p] < 0 && !input.candidatesByHole[p].empty())
+            stuck.push_back({-out.pieces[p].shellVolumeMm3, p});
+    std::sort(stuck.begin(), stuck.end());
+    const std::vector<std::vector<size_t>> slots = slotsOfPieces(field, out.pieces.size());
+    for (const auto& [negVolume, p] : stuck) {
+        context.throwIfCancelled();
+        const MountBody body = makeBody({p}, input, sweeps, field.voxelMm, opt.tenons.maxPerPiece);
+        if (!body.bestFree()) continue;  // the frame is in its way: no cut of the faces frees it
+        std::vector<Vec3d> voxels;
+        std::map<uint32_t, std::vector<Vec3d>> touching;
+        for (size_t s : slots[p]) {
+            if (!field.isInside(s)) continue;
+            const Vec3d x = field.world(field.coordOf(s));
+            voxels.push_back(x);
+            for (int axis = 0; axis < 3; ++axis)
+                for (const double step : {-field.voxelMm, field.voxelMm}) {
+                    Vec3d y = x;
+                    y[size_t(axis)] += step;
+                    const size_t t = field.slotAt(y);
+                    if (t != SIZE_MAX && field.isInside(t) && field.owner[t] != p)
+                        touching[field.owner[t]].push_back(x);
+                }
+        }
+        const std::optional<Keystone> key =
+            findKeystone(p, voxels, touching, body, grouping.faces, usableCandidates(candidates, {p}),
+                         sweeps.frameToGridMm(), search);
+        if (!key) continue;
+        std::string made;
+        for (const SplitPlane& plane : key->planes)
+            made += " " + std::to_string(splitPiece(out.pieces, grouping.cellSets, field, p,
+                                                    {scale(plane.normal, -1.0), -plane.offsetMm}));
+        context.detail("piece " + std::to_string(p) +
+                       " and its neighbours block each other around a hole: a keystone cut out of it "
+                       "along its direction, the wedges beside it new pieces (" +
+                       made.substr(1) + ")");
+        out.recutPieces += key->planes.size();
+        grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
+        return key->planes.size();
+    }
+    return 0;
 }
 
 /// The steps that rely on pegs but got none from @p tenons (their candidates' prisms would meet
@@ -266,6 +327,7 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
     std::vector<TenonCandidate> candidates;
     std::set<std::pair<zome::BallId, int>> lost;  // candidates other pieces' tenons took
     size_t lastUnplaced = SIZE_MAX;
+    int keystones = 0;
     for (int round = 0;; ++round) {
         const Stopwatch clock;
         candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
@@ -276,22 +338,30 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         const PlannerInput input = plannerInput(out, field, candidates);
         context.debug("mounting: plan " + std::to_string(round) + " in " + formatNumber(clock.seconds(), 3) +
                       " s");
-        if (out.plan.isBuildable() || round == kRecutRounds) break;
-        // Re-cutting that places no more pieces is given up: on the cheese at 700 mm the halves
-        // of 116 pieces lining its tunnels were as stuck as the pieces (110 stuck bodies, then 225).
-        const size_t unplaced =
-            size_t(std::count(out.plan.holeOfPiece.begin(), out.plan.holeOfPiece.end(), -1));
-        if (unplaced >= lastUnplaced) {
-            context.detail("mounting: re-cutting placed no more pieces (" + std::to_string(unplaced) +
-                           " without a direction, " + std::to_string(lastUnplaced) +
-                           " before): no more rounds");
-            break;
+        if (out.plan.isBuildable()) break;
+        if (keystones == 0 && round < kRecutRounds) {
+            // Re-cutting that places no more pieces is given up: on the cheese at 700 mm the halves
+            // of 116 pieces lining its tunnels were as stuck as the pieces (110 stuck bodies, then
+            // 225).
+            const size_t unplaced =
+                size_t(std::count(out.plan.holeOfPiece.begin(), out.plan.holeOfPiece.end(), -1));
+            size_t cut = 0;
+            if (unplaced >= lastUnplaced)
+                context.detail("mounting: re-cutting placed no more pieces (" + std::to_string(unplaced) +
+                               " without a direction, " + std::to_string(lastUnplaced) +
+                               " before): no more rounds");
+            else
+                cut = recutBlocked(out, field, cells, grouping, input, candidates, sweeps, opt, context);
+            lastUnplaced = unplaced;
+            context.debug("mounting: re-cut " + std::to_string(cut) + " in " +
+                          formatNumber(clock.seconds(), 3) + " s");
+            if (cut > 0) continue;
         }
-        lastUnplaced = unplaced;
-        const size_t cut = recutBlocked(out, field, cells, grouping, input, candidates, sweeps, opt, context);
-        context.debug("mounting: re-cut " + std::to_string(cut) + " in " + formatNumber(clock.seconds(), 3) +
-                      " s");
-        if (cut == 0) break;
+        // What re-cutting left stuck may be a ring of pieces around a hole: a keystone frees it.
+        if (keystones == kKeystoneRounds ||
+            cutKeystone(out, field, cells, grouping, input, candidates, sweeps, opt, context) == 0)
+            break;
+        ++keystones;
     }
     Replanner replanner(out, field, cells, grouping, probe, frame, frameToGridMm, sweeps, remakeSweeps,
                         candidates, lost, opt, context);
