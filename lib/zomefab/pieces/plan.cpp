@@ -51,6 +51,9 @@ constexpr int kRecutRounds = 5;  ///< plan, re-cut the blocked pieces, plan agai
 /// Keystones cut after the re-cuts, each followed by a plan: a ring around a hole needs one, a few
 /// rings a few.
 constexpr int kKeystoneRounds = 3;
+/// Keystones are tried only while at most this many pieces are placed nowhere: three rings of up to
+/// eight pieces (the torus of docs/mounting.md: 7).
+constexpr size_t kMaxKeystoneStuck = 24;
 
 /// The box every piece's voxels and every ball lie in (grid mm): the frame sweeps' rectangle.
 Box3d planBounds(const VoxelField& field, const zome::Structure& frame, const Transform4d& frameToGridMm) {
@@ -358,7 +361,11 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
             if (cut > 0) continue;
         }
         // What re-cutting left stuck may be a ring of pieces around a hole: a keystone frees it.
-        if (keystones == kKeystoneRounds ||
+        // Not where far more pieces are stuck than a few rings hold (the cheese at 700 mm: 281,
+        // its tunnel linings, and each keystone's plan took 4 minutes there).
+        const size_t unplaced =
+            size_t(std::count(out.plan.holeOfPiece.begin(), out.plan.holeOfPiece.end(), -1));
+        if (keystones == kKeystoneRounds || unplaced > kMaxKeystoneStuck ||
             cutKeystone(out, field, cells, grouping, input, candidates, sweeps, opt, context) == 0)
             break;
         ++keystones;
