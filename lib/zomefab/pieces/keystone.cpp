@@ -13,13 +13,12 @@ namespace {
 /// replaced by a plane parallel to it: the neighbour lies straight ahead.
 constexpr double kMinSine = 0.26;  // 15°
 
-/// The planes that replace the faces of @p piece forbidding removal along @p d, or empty when a
-/// face is nearly square to d; @p isBlocked says whether any face forbids it.
+/// The planes that replace the faces of @p piece forbidding removal along @p d; empty when no face
+/// forbids it or one is nearly square to d.
 std::vector<SplitPlane> keystonePlanes(uint32_t piece, const Vec3d& d,
                                        const std::map<uint32_t, std::vector<Vec3d>>& touching,
-                                       const FaceContacts& faces, double voxelMm, bool* isBlocked) {
+                                       const FaceContacts& faces, double voxelMm) {
     std::vector<SplitPlane> planes;
-    *isBlocked = false;
     for (const auto& [other, points] : touching) {
         const auto it = faces.find({std::min(piece, other), std::max(piece, other)});
         if (it == faces.end() || points.empty()) continue;
@@ -28,7 +27,6 @@ std::vector<SplitPlane> keystonePlanes(uint32_t piece, const Vec3d& d,
             // The stored normal points from the lower piece into the higher: here, into piece.
             const Vec3d n = other < piece ? c.normal : scale(c.normal, -1.0);
             if (dot(d, n) >= 0.0) continue;  // the face lets the piece slide off along d
-            *isBlocked = true;
             const Vec3d m = madd(n, -dot(n, d), d);
             if (norm(m) < kMinSine) return {};
             const Vec3d unit = normalized(m);
@@ -68,9 +66,7 @@ std::optional<Keystone> findKeystone(uint32_t piece, const std::vector<Vec3d>& v
     for (const DirectionOption& o : body.options) {
         if (!o.isTested || !o.isFree || o.tenons == 0) continue;
         const Vec3d d = gridDirection(o.hole, frameToGridMm);
-        bool isBlocked = false;
-        const std::vector<SplitPlane> planes =
-            keystonePlanes(piece, d, touching, faces, search.voxelMm, &isBlocked);
+        const std::vector<SplitPlane> planes = keystonePlanes(piece, d, touching, faces, search.voxelMm);
         if (planes.empty() || !partsLargeEnough(voxels, planes, minVoxels)) continue;
         // A tenon along d whose wall point stays in the keystone, clear of the new faces.
         const bool isHeld = std::any_of(candidates.begin(), candidates.end(), [&](const TenonCandidate* c) {

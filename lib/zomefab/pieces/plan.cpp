@@ -342,12 +342,12 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         context.debug("mounting: plan " + std::to_string(round) + " in " + formatNumber(clock.seconds(), 3) +
                       " s");
         if (out.plan.isBuildable()) break;
+        const size_t unplaced =
+            size_t(std::count(out.plan.holeOfPiece.begin(), out.plan.holeOfPiece.end(), -1));
         if (keystones == 0 && round < kRecutRounds) {
             // Re-cutting that places no more pieces is given up: on the cheese at 700 mm the halves
             // of 116 pieces lining its tunnels were as stuck as the pieces (110 stuck bodies, then
             // 225).
-            const size_t unplaced =
-                size_t(std::count(out.plan.holeOfPiece.begin(), out.plan.holeOfPiece.end(), -1));
             size_t cut = 0;
             if (unplaced >= lastUnplaced)
                 context.detail("mounting: re-cutting placed no more pieces (" + std::to_string(unplaced) +
@@ -363,8 +363,6 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         // What re-cutting left stuck may be a ring of pieces around a hole: a keystone frees it.
         // Not where far more pieces are stuck than a few rings hold (the cheese at 700 mm: 281,
         // its tunnel linings, and each keystone's plan took 4 minutes there).
-        const size_t unplaced =
-            size_t(std::count(out.plan.holeOfPiece.begin(), out.plan.holeOfPiece.end(), -1));
         if (keystones == kKeystoneRounds || unplaced > kMaxKeystoneStuck ||
             cutKeystone(out, field, cells, grouping, input, candidates, sweeps, opt, context) == 0)
             break;
