@@ -623,6 +623,41 @@ TEST_CASE("pieces: two pieces merged into one keep every voxel, and the others a
     CHECK_FALSE(isMergeable(g.cellSets, 1, 1));
 }
 
+TEST_CASE("pieces: the two halves of a split are merged back into the piece before it") {
+    QuadrantPieces q = quadrantPieces();
+    VoxelField& field = q.field;
+    Grouping& g = q.grouping;
+    REQUIRE(g.pieces.size() == 4);
+    const std::vector<uint32_t> owners = field.owner;
+    const double volume = g.pieces[1].shellVolumeMm3;
+    // Cut piece 1 at the middle of its voxels along x (and piece 2 by another plane, once).
+    double lo = 1e9, hi = -1e9;
+    for (size_t s = 0; s < field.phi.size(); ++s)
+        if (field.isActive[s] && field.owner[s] == 1) {
+            const double x = field.world(field.coordOf(s))[0];
+            lo = std::min(lo, x), hi = std::max(hi, x);
+        }
+    const uint32_t half = splitPiece(g.pieces, g.cellSets, field, 1, {{1, 0, 0}, 0.5 * (lo + hi)});
+    REQUIRE(half == 4);
+    splitPiece(g.pieces, g.cellSets, field, 2, {{0, 1, 0}, 0.0});
+    CHECK_FALSE(isMergeable(g.cellSets, 1, 4));
+    REQUIRE(splitPlaneBetween(g.cellSets, 1, 4) == size_t(0));
+    CHECK(splitPlaneBetween(g.cellSets, 4, 1) == size_t(0));
+    CHECK_FALSE(splitPlaneBetween(g.cellSets, 1, 2));  // other cells
+    CHECK_FALSE(splitPlaneBetween(g.cellSets, 1, 5));  // other cells, another plane
+    CHECK_FALSE(splitPlaneBetween(g.cellSets, 0, 3));  // no planes: isMergeable's case
+    CHECK_FALSE(splitPlaneBetween(g.cellSets, 1, 1));
+
+    CHECK(mergePieces(g.pieces, g.cellSets, field, 1, 4) == 1);
+    CHECK(g.cellSets[1].halfSpaces.empty());  // the region of its cells again
+    CHECK(g.pieces[1].shellVolumeMm3 == doctest::Approx(volume));
+    size_t moved = 0;  // voxels of the piece before the cut that another owns now
+    for (size_t s = 0; s < field.phi.size(); ++s) moved += owners[s] == 1 && field.owner[s] != 1 ? 1 : 0;
+    CHECK(moved == 0);
+    // The halves of piece 2 (now 2 and 4) are not merged by isMergeable, but by their plane.
+    CHECK(splitPlaneBetween(g.cellSets, 2, 4) == size_t(0));
+}
+
 TEST_CASE("pieces: a piece whose tenon reaches past the printer is cut; the others are left as they are") {
     // Four quadrants of the 200 mm shell, each about 100 × 200 × 100 mm: all fit a 210 mm printer.
     // A tenon on piece 0 reaching 205 mm below the sphere makes it 405 mm long: longer than the

@@ -9,26 +9,18 @@
 set -u
 zf=$1 out=$2
 rm -rf "$out" "$out.failed" "$out.stl"
-python3 - "$out.stl" <<'PY'
-import math, struct, sys
+. "$(dirname "$0")/made_mesh.sh"
+make_stl "$out.stl" <<'PY'
 R, r, N, M = 150.0, 70.0, 96, 48  # centre circle and tube radius (mm), segments around each
 def point(i, j):
     u, v = 2 * math.pi * (i % N) / N, 2 * math.pi * (j % M) / M
     return ((R + r * math.cos(v)) * math.cos(u), (R + r * math.cos(v)) * math.sin(u), r * math.sin(v))
-tris = []
 for i in range(N):
     for j in range(M):
         a, b, c, d = point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)
         tris += [(a, b, c), (a, c, d)]
-with open(sys.argv[1], "wb") as f:
-    f.write(b"torus".ljust(80, b" ") + struct.pack("<I", len(tris)))
-    for t in tris:
-        f.write(struct.pack("<12fH", 0, 0, 0, *t[0], *t[1], *t[2], 0))
 PY
-"$zf" run "$out.stl" --up z --height-mm 140 -o "$out" -v 2>"$out.err"
-rc=$?
-grep -E "keystone|cannot be put on|verify:" "$out.err" | cut -c1-300
-[ $rc -eq 0 ] || { echo "zomefab run exited $rc"; tail -3 "$out.err"; exit 1; }
+run_made "$zf" "$out.stl" 140 "$out" "keystone|cannot be put on" || exit 1
 grep -q "a keystone cut out of it" "$out.err" || { echo "no keystone was cut"; exit 1; }
 python3 -c "
 import json, sys

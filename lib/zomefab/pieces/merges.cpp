@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <iterator>
+#include <optional>
 #include <set>
 
 #include "zomefab/pieces/detail/splits.h"
@@ -34,8 +35,25 @@ bool isMergeable(const std::vector<CellSet>& sets, uint32_t a, uint32_t b) {
     return a != b && sets[a].halfSpaces.empty() && sets[b].halfSpaces.empty();
 }
 
+std::optional<size_t> splitPlaneBetween(const std::vector<CellSet>& sets, uint32_t a, uint32_t b) {
+    const CellSet &x = sets[a], &y = sets[b];
+    if (a == b || x.members != y.members || x.halfSpaces.size() != y.halfSpaces.size()) return std::nullopt;
+    std::optional<size_t> differing;
+    for (size_t i = 0; i < x.halfSpaces.size(); ++i) {
+        const CellSet::HalfSpace &h = x.halfSpaces[i], &k = y.halfSpaces[i];
+        if (h.normal == k.normal && h.offsetMm == k.offsetMm) continue;
+        const bool isOpposite = h.normal == scale(k.normal, -1.0) && h.offsetMm == -k.offsetMm;
+        if (!isOpposite || differing) return std::nullopt;
+        differing = i;
+    }
+    return differing;
+}
+
 uint32_t mergePieces(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field, uint32_t keep,
                      uint32_t gone) {
+    // The two halves of one split: the union is the piece before it, without that plane.
+    if (const std::optional<size_t> plane = splitPlaneBetween(sets, keep, gone))
+        sets[keep].halfSpaces.erase(sets[keep].halfSpaces.begin() + std::ptrdiff_t(*plane));
     Piece& k = pieces[keep];
     const Piece& g = pieces[gone];
     k.cells = sortedUnion(k.cells, g.cells);

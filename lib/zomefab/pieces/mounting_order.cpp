@@ -9,6 +9,7 @@
 #include <set>
 #include <tuple>
 
+#include "zomefab/core/format.h"
 #include "zomefab/mount/sweep.h"
 #include "zomefab/pieces/detail/mounting.h"
 #include "zomefab/zome/holes.h"
@@ -504,7 +505,18 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
         for (size_t k = 0; k < parts.stuck.size(); ++k) {
             std::string in;
             for (uint32_t o : parts.stuckBlockers[k]) in += " " + bodyName(bodies.list[o]);
-            context.debug("mounting: stuck: " + bodyName(bodies.list[parts.stuck[k]]) + ", in its way:" + in);
+            // Where it is and which way it would go (grid mm; none: no peg holds it), to find it.
+            const MountBody& body = bodies.list[parts.stuck[k]];
+            const Vec3d &lo = body.bounds.min, &hi = body.bounds.max;
+            std::string d = " (no peg holds it)";
+            if (const DirectionOption* o = body.bestFree()) {
+                const Vec3d v = gridDirection(o->hole, sweeps.frameToGridMm());
+                d = formatNumbers(" along (%.2f, %.2f, %.2f)", v[0], v[1], v[2]);
+            }
+            context.debug("mounting: stuck: " + bodyName(body) +
+                          formatNumbers(" in (%.0f, %.0f, %.0f)-(%.0f, %.0f, %.0f) mm", lo[0], lo[1], lo[2],
+                                        hi[0], hi[1], hi[2]) +
+                          d + ", in its way:" + in);
         }
         const size_t glued =
             glueStuck(bodies, parts, input, sweeps, faces, voxelMm, maxPerPiece, noFreeUnion);

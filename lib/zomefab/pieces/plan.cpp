@@ -18,6 +18,7 @@
 #include "zomefab/pieces/detail/replan.h"
 #include "zomefab/pieces/detail/splits.h"
 #include "zomefab/pieces/detail/stages.h"
+#include "zomefab/pieces/detail/tunnels.h"
 
 namespace zomefab::pieces::detail {
 
@@ -54,6 +55,10 @@ constexpr int kKeystoneRounds = 3;
 /// Keystones are tried only while at most this many pieces are placed nowhere: three rings of up to
 /// eight pieces (the torus of docs/mounting.md: 7).
 constexpr size_t kMaxKeystoneStuck = 24;
+/// Tunnel linings are cut into slabs this long along the tunnel (mm): short enough that the seams
+/// the partition left along the tunnel seldom zigzag within one slab, long enough not to double the
+/// pieces of a lining 200 mm long.
+constexpr double kTunnelSlabMm = 80.0;
 
 /// The box every piece's voxels and every ball lie in (grid mm): the frame sweeps' rectangle.
 Box3d planBounds(const VoxelField& field, const zome::Structure& frame, const Transform4d& frameToGridMm) {
@@ -164,6 +169,102 @@ size_t cutKeystone(Pieces& out, VoxelField& field, const GridCells& cells, Group
         return key->planes.size();
     }
     return 0;
+}
+
+/// Joins the pieces of each tunnel of @p groups that touch into one where the union is a cell
+/// region again (isMergeable, or the two halves of one split: splitPlaneBetween), until no two can
+/// be; the groups' piece ids follow. Returns how many joins.
+size_t joinLinings(std::vector<TunnelGroup>& groups, Pieces& out, VoxelField& field, Grouping& grouping) {
+    std::set<std::pair<uint32_t, uint32_t>> touching;  // (lower, higher) id, kept as ids change
+    for (const auto& [pair, contacts] : grouping.faces) touching.insert(pair);
+    size_t joins = 0;
+    for (bool isJoined = true; isJoined;) {
+        isJoined = false;
+        for (TunnelGroup& g : groups) {
+            for (size_t i = 0; i < g.pieces.size() && !isJoined; ++i)
+                for (size_t j = i + 1; j < g.pieces.size() && !isJoined; ++j) {
+                    const uint32_t keep = g.pieces[i], gone = g.pieces[j];  // sorted: keep < gone
+                    if (!touching.count({keep, gone}) || (!isMergeable(grouping.cellSets, keep, gone) &&
+                                                          !splitPlaneBetween(grouping.cellSets, keep, gone)))
+                        continue;
+                    mergePieces(out.pieces, grouping.cellSets, field, keep, gone);
+                    auto now = [&](uint32_t id) { return id == gone ? keep : id > gone ? id - 1 : id; };
+                    std::set<std::pair<uint32_t, uint32_t>> next;
+                    for (const auto& [a, b] : touching)
+                        if (now(a) != now(b))
+                            next.insert({std::min(now(a), now(b)), std::max(now(a), now(b))});
+                    touching = std::move(next);
+                    for (TunnelGroup& h : groups) {
+                        for (uint32_t& p : h.pieces) p = now(p);
+                        std::sort(h.pieces.begin(), h.pieces.end());
+                        h.pieces.erase(std::unique(h.pieces.begin(), h.pieces.end()), h.pieces.end());
+                    }
+                    isJoined = true, ++joins;
+                }
+            if (isJoined) break;
+        }
+    }
+    return joins;
+}
+
+/// Cuts the linings of tunnels into slabs (detail/tunnels.h): the pieces a plan without gluing
+/// leaves stuck that no peg holds, grouped by an axis each is free of the frame along, cut by planes
+/// across the axis at the multiples of kTunnelSlabMm. Returns how many cuts.
+size_t cutTunnelLinings(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
+                        const PlannerInput& input, const FrameSweeps& sweeps, const PiecesOptions& opt,
+                        const RunContext& context) {
+    PlannerInput unglued = input;
+    unglued.isGluingStuck = false;
+    const std::vector<int> holes = tenonHoleSet(opt.tenons.holes);
+    const mount::InstallationPlan plan =
+        planMounting(unglued, sweeps, grouping.faces, field.voxelMm, holes, opt.tenons.maxPerPiece, context);
+    std::vector<uint32_t> lining;
+    std::vector<std::vector<Vec3d>> freeAlong;
+    for (uint32_t p = 0; p < out.pieces.size(); ++p) {
+        if (plan.holeOfPiece[p] >= 0) continue;
+        context.throwIfCancelled();
+        MountBody body = makeBody({p}, input, sweeps, field.voxelMm, opt.tenons.maxPerPiece, 1);
+        if (body.bestFree()) continue;  // held by pegs: stuck between pieces, not a lining
+        addGlueOptions(body, holes, sweeps, field.voxelMm);
+        std::vector<Vec3d> dirs;
+        for (const DirectionOption& o : body.glueOptions)
+            if (o.isFree) dirs.push_back(gridDirection(o.hole, sweeps.frameToGridMm()));
+        if (dirs.empty()) continue;
+        lining.push_back(p);
+        freeAlong.push_back(std::move(dirs));
+    }
+    std::vector<TunnelGroup> groups = tunnelGroups(lining, freeAlong);
+    if (groups.empty()) return 0;
+    // The lining pieces of a tunnel that touch become one, so that each slab is a ring: the seams
+    // the partition left along the tunnel wander, and two slabs with such a seam between them
+    // block each other along the tunnel both ways.
+    const size_t joins = joinLinings(groups, out, field, grouping);
+    const std::vector<std::vector<size_t>> slots = slotsOfPieces(field, out.pieces.size());
+    const double voxelMm3 = field.voxelMm * field.voxelMm * field.voxelMm;
+    const size_t minVoxels = size_t(std::ceil(splitSearchFor(field, opt).minVolumeMm3 / voxelMm3));
+    size_t cuts = 0;
+    for (const TunnelGroup& g : groups) {
+        size_t groupCuts = 0;
+        for (uint32_t p : g.pieces) {
+            std::vector<double> t;
+            for (size_t s : slots[p])
+                if (field.isInside(s)) t.push_back(dot(g.axis, field.world(field.coordOf(s))));
+            uint32_t rest = p;  // the part beyond the planes cut so far
+            for (double at : slabOffsets(t, kTunnelSlabMm, minVoxels))
+                rest = splitPiece(out.pieces, grouping.cellSets, field, rest, {g.axis, at}), ++groupCuts;
+        }
+        if (groupCuts == 0) continue;
+        context.detail("mounting: " + std::to_string(g.lining) + " pieces line a tunnel along (" +
+                       formatNumber(g.axis[0], 2) + ", " + formatNumber(g.axis[1], 2) + ", " +
+                       formatNumber(g.axis[2], 2) + "), no peg holds them and no order exists: joined into " +
+                       std::to_string(g.pieces.size()) + " and cut across it into slabs " +
+                       std::to_string(int(kTunnelSlabMm)) + " mm long (" + std::to_string(groupCuts) +
+                       " cuts)");
+        cuts += groupCuts;
+    }
+    out.recutPieces += cuts;
+    if (cuts > 0 || joins > 0) grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
+    return cuts;
 }
 
 /// The steps that rely on pegs but got none from @p tenons (their candidates' prisms would meet
@@ -344,6 +445,10 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         if (out.plan.isBuildable()) break;
         const size_t unplaced =
             size_t(std::count(out.plan.holeOfPiece.begin(), out.plan.holeOfPiece.end(), -1));
+        // Pieces lining a tunnel: cut across it into slabs once, before any re-cut (which would
+        // cut them along it).
+        if (round == 0 && cutTunnelLinings(out, field, cells, grouping, input, sweeps, opt, context) > 0)
+            continue;
         if (keystones == 0 && round < kRecutRounds) {
             // Re-cutting that places no more pieces is given up: on the cheese at 700 mm the halves
             // of 116 pieces lining its tunnels were as stuck as the pieces (110 stuck bodies, then

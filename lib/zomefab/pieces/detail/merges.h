@@ -6,6 +6,7 @@
 /// docs/mounting.md, "Merged pieces".
 #pragma once
 
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -19,10 +20,16 @@ namespace zomefab::pieces::detail {
 /// union of cells and so is the union of the two.
 bool isMergeable(const std::vector<CellSet>& sets, uint32_t a, uint32_t b);
 
+/// Whether pieces @p a and @p b are the two halves of one piece cut by a plane (splitPiece): the
+/// same cells, the same planes but one, which each has the other way round. Its index in their
+/// planes, or empty. Their union is then the piece before the cut: exactly a cell region again.
+std::optional<size_t> splitPlaneBetween(const std::vector<CellSet>& sets, uint32_t a, uint32_t b);
+
 /// Makes piece @p gone part of piece @p keep (cells, requests, slivers, shell volume, voxels; the
 /// cutters of the union recounted: a cell the two shared alone is no longer cut), removes @p gone
 /// and numbers the pieces after it one lower (ids and voxel owners). Returns keep's new id. The
-/// caller recomputes the face contacts (faceContacts). @pre isMergeable(sets, keep, gone).
+/// caller recomputes the face contacts (faceContacts). @pre isMergeable(sets, keep, gone), or the
+/// two are the halves of one split (splitPlaneBetween; keep loses that plane).
 uint32_t mergePieces(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field, uint32_t keep,
                      uint32_t gone);
 
