@@ -59,6 +59,9 @@ constexpr size_t kMaxKeystoneStuck = 24;
 /// the partition left along the tunnel seldom zigzag within one slab, long enough not to double the
 /// pieces of a lining 200 mm long.
 constexpr double kTunnelSlabMm = 80.0;
+/// Tunnel linings are cut only while at most this many pieces are placed nowhere: a few tunnels'
+/// linings (the 300 mm cube's: 19 pieces), not the cheese's hundreds (docs/benchmarks.md, "Tunnels").
+constexpr size_t kMaxTunnelStuck = 100;
 
 /// The box every piece's voxels and every ball lie in (grid mm): the frame sweeps' rectangle.
 Box3d planBounds(const VoxelField& field, const zome::Structure& frame, const Transform4d& frameToGridMm) {
@@ -446,8 +449,12 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         const size_t unplaced =
             size_t(std::count(out.plan.holeOfPiece.begin(), out.plan.holeOfPiece.end(), -1));
         // Pieces lining a tunnel: cut across it into slabs once, before any re-cut (which would
-        // cut them along it).
-        if (round == 0 && cutTunnelLinings(out, field, cells, grouping, input, sweeps, opt, context) > 0)
+        // cut them along it). Not where far more pieces are placed nowhere than a few tunnels' linings
+        // (the cheese at 700 mm: cavity linings taken for tunnels, nothing freed, each plan minutes).
+        context.debug("mounting: " + std::to_string(unplaced) + " pieces placed nowhere by plan " +
+                      std::to_string(round));
+        if (round == 0 && unplaced <= kMaxTunnelStuck &&
+            cutTunnelLinings(out, field, cells, grouping, input, sweeps, opt, context) > 0)
             continue;
         if (keystones == 0 && round < kRecutRounds) {
             // Re-cutting that places no more pieces is given up: on the cheese at 700 mm the halves
