@@ -117,6 +117,17 @@ size_t recutBlocked(Pieces& out, VoxelField& field, const GridCells& cells, Grou
     return cut;
 }
 
+/// The plan made once more without gluing stuck bodies: the pieces stuck on their own (a plan's
+/// glued groups hide which piece a ring turns on, or which pieces line a tunnel).
+mount::InstallationPlan planUnglued(const PlannerInput& input, const FrameSweeps& sweeps,
+                                    const Grouping& grouping, double voxelMm, const PiecesOptions& opt,
+                                    const RunContext& context) {
+    PlannerInput unglued = input;
+    unglued.isGluingStuck = false;
+    return planMounting(unglued, sweeps, grouping.faces, voxelMm, tenonHoleSet(opt.tenons.holes),
+                        opt.tenons.maxPerPiece, context);
+}
+
 /// Cuts a keystone out of one piece that is free of the frame alone but placed nowhere (the
 /// largest for which findKeystone finds one): the wedges along the faces that block it become
 /// pieces of their own. Returns how many pieces were added (0: none found).
@@ -124,12 +135,7 @@ size_t cutKeystone(Pieces& out, VoxelField& field, const GridCells& cells, Group
                    const PlannerInput& input, const std::vector<TenonCandidate>& candidates,
                    const FrameSweeps& sweeps, const PiecesOptions& opt, const RunContext& context) {
     const SplitSearch search = splitSearchFor(field, opt);
-    // The pieces stuck before any gluing: the plan's glued groups hide which piece the ring turns on.
-    PlannerInput unglued = input;
-    unglued.isGluingStuck = false;
-    const mount::InstallationPlan plan =
-        planMounting(unglued, sweeps, grouping.faces, field.voxelMm, tenonHoleSet(opt.tenons.holes),
-                     opt.tenons.maxPerPiece, context);
+    const mount::InstallationPlan plan = planUnglued(input, sweeps, grouping, field.voxelMm, opt, context);
     std::vector<std::pair<double, uint32_t>> stuck;  // (−volume, piece)
     for (uint32_t p = 0; p < out.pieces.size(); ++p)
         if (plan.holeOfPiece[p] < 0 && !input.candidatesByHole[p].empty())
@@ -216,11 +222,8 @@ size_t joinLinings(std::vector<TunnelGroup>& groups, Pieces& out, VoxelField& fi
 size_t cutTunnelLinings(Pieces& out, VoxelField& field, const GridCells& cells, Grouping& grouping,
                         const PlannerInput& input, const FrameSweeps& sweeps, const PiecesOptions& opt,
                         const RunContext& context) {
-    PlannerInput unglued = input;
-    unglued.isGluingStuck = false;
     const std::vector<int> holes = tenonHoleSet(opt.tenons.holes);
-    const mount::InstallationPlan plan =
-        planMounting(unglued, sweeps, grouping.faces, field.voxelMm, holes, opt.tenons.maxPerPiece, context);
+    const mount::InstallationPlan plan = planUnglued(input, sweeps, grouping, field.voxelMm, opt, context);
     std::vector<uint32_t> lining;
     std::vector<std::vector<Vec3d>> freeAlong;
     for (uint32_t p = 0; p < out.pieces.size(); ++p) {
