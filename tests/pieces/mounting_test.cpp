@@ -35,6 +35,7 @@ MountBody slab(uint32_t piece, double x0, double x1, double z0, double z1) {
             for (double z = z0; z <= z1 + 1e-9; z += 1.0) {
                 b.voxels.push_back({x, y, z});
                 b.nearCutOf.push_back({kNone, kNone});
+                b.cutLayer.push_back({0, 0});
                 b.bounds.expand({x, y, z});
             }
     return b;
@@ -44,7 +45,10 @@ MountBody slab(uint32_t piece, double x0, double x1, double z0, double z1) {
 /// voxels within two of the seam): the face, not the sweep, orders the two.
 void nearEachOther(MountBody& a, MountBody& b) {
     for (auto [m, other] : {std::pair{&a, &b}, std::pair{&b, &a}})
-        for (auto& near : m->nearCutOf) (near[0] == kNone ? near[0] : near[1]) = other->pieces[0];
+        for (size_t i = 0; i < m->voxels.size(); ++i) {
+            const size_t k = m->nearCutOf[i][0] == kNone ? 0 : 1;
+            m->nearCutOf[i][k] = other->pieces[0], m->cutLayer[i][k] = 1;
+        }
 }
 
 /// A direction the body could take: free of the frame, with @p tenons tenons.
@@ -200,7 +204,7 @@ TEST_CASE("mounting: a voxel near one neighbour's seam is still swept against th
     // Two voxels deep on each side of a seam, as the planner marks them.
     auto markNear = [](MountBody& m, uint32_t other, auto isNear) {
         for (size_t i = 0; i < m.voxels.size(); ++i)
-            if (isNear(m.voxels[i])) m.nearCutOf[i][0] = other;
+            if (isNear(m.voxels[i])) m.nearCutOf[i][0] = other, m.cutLayer[i][0] = 1;
     };
     markNear(a, 2, [](const Vec3d& x) { return x[0] >= 9; });
     markNear(c, 0, [](const Vec3d& x) { return x[0] <= 12; });
@@ -208,6 +212,7 @@ TEST_CASE("mounting: a voxel near one neighbour's seam is still swept against th
     markNear(d, 2, [](const Vec3d& x) { return x[2] <= 23; });
     c.voxels.insert(c.voxels.end(), arm.voxels.begin(), arm.voxels.end());
     c.nearCutOf.insert(c.nearCutOf.end(), arm.nearCutOf.begin(), arm.nearCutOf.end());
+    c.cutLayer.insert(c.cutLayer.end(), arm.cutLayer.begin(), arm.cutLayer.end());
     c.bounds.expand(arm.bounds.min), c.bounds.expand(arm.bounds.max);
     const FaceContacts faces = {{{0, 2}, {CutContact{{1, 0, 0}, 121}}},
                                 {{2, 3}, {CutContact{{0, 0, 1}, 121}}}};
@@ -219,6 +224,40 @@ TEST_CASE("mounting: a voxel near one neighbour's seam is still swept against th
     const Disassembly r = disassembleAll({a, b, c, d}, faces);
     CHECK(r.stuck.empty());
     CHECK(std::count(r.before.begin(), r.before.end(), std::make_pair(uint32_t(0), uint32_t(2))) == 1);
+}
+
+TEST_CASE("mounting: a voxel near a seam is swept against the neighbour's voxels away from it") {
+    // A slides up along its seam with C (x = 10.5), whose arm reaches round A's top, over A's seam
+    // voxels (x 9–10, z 14–15), away from the seam. A pushed off upward meets the arm, so A goes on
+    // before C. (With A's near-seam voxels left out of every sweep against C, as once, A went on
+    // last and ran into the arm: a 400 mm cube with a tunnel, 11.6 mm into a neighbour.)
+    MountBody a = slab(0, 0, 10, 0, 10), c = slab(2, 11, 21, 0, 10), arm = slab(2, 9, 21, 14, 15);
+    auto markNear = [](MountBody& m, uint32_t other, auto isNear, uint8_t layer = 1) {
+        for (size_t i = 0; i < m.voxels.size(); ++i)
+            if (isNear(m.voxels[i])) m.nearCutOf[i][0] = other, m.cutLayer[i][0] = layer;
+    };
+    markNear(a, 2, [](const Vec3d& x) { return x[0] >= 9; });
+    markNear(c, 0, [](const Vec3d& x) { return x[0] <= 12; });
+    c.voxels.insert(c.voxels.end(), arm.voxels.begin(), arm.voxels.end());
+    c.nearCutOf.insert(c.nearCutOf.end(), arm.nearCutOf.begin(), arm.nearCutOf.end());
+    c.cutLayer.insert(c.cutLayer.end(), arm.cutLayer.begin(), arm.cutLayer.end());
+    c.bounds.expand(arm.bounds.min), c.bounds.expand(arm.bounds.max);
+    const FaceContacts faces = {{{0, 2}, {CutContact{{1, 0, 0}, 121}}}};
+    a.options = {option(kUp, 2)};
+    c.options = {option(kRight, 2)};
+    MountBody b = slab(1, 200, 210, 0, 5);  // bodies are named by their index: piece 1 far away
+    b.options = {option(kUp, 2)};
+    const Disassembly r = disassembleAll({a, b, c}, faces);
+    CHECK(r.stuck.empty());
+    CHECK(std::count(r.before.begin(), r.before.end(), std::make_pair(uint32_t(0), uint32_t(2))) == 1);
+    // Where the arm lies just behind the seam (its voxels three layers from A's face, as behind a
+    // seam along a diagonal plane), A's seam voxels are not swept against it and the face lets A
+    // slide up: no order between them.
+    markNear(
+        c, 0, [](const Vec3d& x) { return x[2] >= 14; }, kWideCutLayers - 1);
+    const Disassembly free = disassembleAll({a, b, c}, faces);
+    CHECK(free.stuck.empty());
+    CHECK(std::count(free.before.begin(), free.before.end(), std::make_pair(uint32_t(0), uint32_t(2))) == 0);
 }
 
 TEST_CASE("mounting: a tenon of a piece already on that lies in a later piece's path is given up") {

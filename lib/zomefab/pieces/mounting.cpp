@@ -84,10 +84,10 @@ bool FrameSweeps::isFree(const MountBody& body, int hole, double voxelMm, std::s
     return !hit.isHit;
 }
 
-bool MountBody::isNearCutWith(size_t i, const MountBody& other) const {
-    for (uint32_t piece : nearCutOf[i])
-        if (piece != kNone &&
-            std::find(other.pieces.begin(), other.pieces.end(), piece) != other.pieces.end())
+bool MountBody::isNearCutWith(size_t i, const MountBody& other, uint8_t layers) const {
+    for (size_t k = 0; k < 2; ++k)
+        if (nearCutOf[i][k] != kNone && cutLayer[i][k] <= layers &&
+            std::find(other.pieces.begin(), other.pieces.end(), nearCutOf[i][k]) != other.pieces.end())
             return true;
     return false;
 }
@@ -101,16 +101,20 @@ PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
     for (uint32_t p = 0; p < n; ++p) in.pieces[p].pieces = {p};
     // A body pushed along d first meets things with its rearmost points, which lie on its surface:
     // the inside voxels with a 6-neighbour outside the wall or in another piece are enough.
-    std::vector<uint8_t> isSurface(field.phi.size(), 0), nearCut(field.phi.size(), 0);
-    // The pieces across the cut faces each near-cut voxel is near (up to two).
+    std::vector<uint8_t> isSurface(field.phi.size(), 0);
+    // The pieces across the cut faces each near-cut voxel is near (up to two), and its layer from
+    // each face (1: on it, up to kWideCutLayers).
     std::vector<std::array<uint32_t, 2>> nearOf(field.phi.size(), {kNone, kNone});
-    auto addNear = [&](size_t s, uint32_t piece) {
+    std::vector<std::array<uint8_t, 2>> layerOf(field.phi.size(), {0, 0});
+    auto addNear = [&](size_t s, uint32_t piece, uint8_t layer) {
         auto& list = nearOf[s];
-        if (list[0] == piece || list[1] == piece) return;
-        if (list[0] == kNone)
-            list[0] = piece;
-        else if (list[1] == kNone)
-            list[1] = piece;
+        for (size_t k = 0; k < 2; ++k)
+            if (list[k] == piece) return;  // reached before, in an earlier (nearer) layer
+        for (size_t k = 0; k < 2; ++k)
+            if (list[k] == kNone) {
+                list[k] = piece, layerOf[s][k] = layer;
+                return;
+            }
         // Near a third piece's face too (a corner): swept against that one, the safe side.
     };
     // Voxel faces per cut face (as faceContacts counts them): only faces large enough to order
@@ -130,29 +134,30 @@ PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
         if (ia && (!ib || isCut)) isSurface[a] = 1;
         if (ib && (!ia || isCut)) isSurface[b] = 1;
         if (isCut && faceSize[faceKey(a, b)] >= kMinOrderFaceVoxels) {
-            nearCut[a] = nearCut[b] = 2;
-            addNear(a, field.owner[b]);
-            addNear(b, field.owner[a]);
+            addNear(a, field.owner[b], 1);
+            addNear(b, field.owner[a], 1);
         }
     });
-    // One more layer inward from the cut faces (6-neighbours in the same piece).
-    forEachForwardPair(field, [&](size_t a, size_t b) {
-        if (!field.isInside(a) || !field.isInside(b) || field.owner[a] != field.owner[b]) return;
-        auto spread = [&](size_t from, size_t to) {
-            if (nearCut[from] != 2 || nearCut[to] == 2) return;
-            nearCut[to] = 1;
-            for (uint32_t piece : nearOf[from])
-                if (piece != kNone) addNear(to, piece);
-        };
-        spread(a, b);
-        spread(b, a);
-    });
+    // Layer by layer inward from the cut faces (6-neighbours in the same piece): a pass spreads
+    // layer k to k + 1 only, so one pass never spreads twice.
+    for (uint8_t layer = 1; layer < kWideCutLayers; ++layer)
+        forEachForwardPair(field, [&](size_t a, size_t b) {
+            if (!field.isInside(a) || !field.isInside(b) || field.owner[a] != field.owner[b]) return;
+            auto spread = [&](size_t from, size_t to) {
+                for (size_t k = 0; k < 2; ++k)
+                    if (nearOf[from][k] != kNone && layerOf[from][k] == layer)
+                        addNear(to, nearOf[from][k], uint8_t(layer + 1));
+            };
+            spread(a, b);
+            spread(b, a);
+        });
     for (size_t s = 0; s < field.phi.size(); ++s)
         if (isSurface[s] && field.owner[s] < n) {
             const Vec3d x = field.world(field.coordOf(s));
             MountBody& body = in.pieces[field.owner[s]];
             body.voxels.push_back(x);
             body.nearCutOf.push_back(nearOf[s]);
+            body.cutLayer.push_back(layerOf[s]);
             body.bounds.expand(x);
         }
     for (const TenonCandidate& c : candidates) {
@@ -224,6 +229,7 @@ MountBody makeBody(const std::vector<uint32_t>& members, const PlannerInput& inp
         const MountBody& piece = input.pieces[p];
         body.voxels.insert(body.voxels.end(), piece.voxels.begin(), piece.voxels.end());
         body.nearCutOf.insert(body.nearCutOf.end(), piece.nearCutOf.begin(), piece.nearCutOf.end());
+        body.cutLayer.insert(body.cutLayer.end(), piece.cutLayer.begin(), piece.cutLayer.end());
         body.bounds.expand(piece.bounds.min), body.bounds.expand(piece.bounds.max);
         for (const auto& [hole, entry] : input.candidatesByHole[p]) {
             byHole[hole].first += entry.first;

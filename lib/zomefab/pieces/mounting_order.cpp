@@ -45,16 +45,43 @@ bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, 
     Box3d bounds = moving.bounds;
     bounds.expand(still.bounds.min), bounds.expand(still.bounds.max);
     const mount::SweepAxes axes(d);
-    mount::DepthRaster obstacle(axes, bounds, voxelMm, true, voxelMm),
-        body(axes, bounds, voxelMm, false, voxelMm);
-    // Neighbours: the voxels along their cut faces are left to facesAllow (seen along a face nearly
-    // parallel to d, the voxels on its two sides would seem to lie ahead of each other).
-    for (size_t i = 0; i < still.voxels.size(); ++i)
-        if (!isTouching || !still.isNearCutWith(i, moving))
-            obstacle.addPoint(still.voxels[i], 0.5 * voxelMm, uint32_t(i));
-    for (size_t i = 0; i < moving.voxels.size(); ++i)
-        if (!isTouching || !moving.isNearCutWith(i, still)) body.addPoint(moving.voxels[i], 0.0, uint32_t(i));
-    return mount::worstHit(obstacle, body, voxelMm).isHit;
+    // Neighbours: a voxel of one near their cut face (kNearCutLayers) meeting a voxel of the other
+    // near it is left to facesAllow (seen along a face nearly parallel to d, the voxels on its two
+    // sides would seem to lie ahead of each other). Near voxels are swept against the other's
+    // voxels away from the face (beyond kWideCutLayers), which may reach round the face's end into
+    // the path (a 400 mm cube with a tunnel: a piece ran 11.6 mm into a neighbour that wraps round
+    // its end, beside a 94 mm² face whose plane the path slides along); the rest against all.
+    auto raster = [&](bool isObstacle) {
+        return mount::DepthRaster(axes, bounds, voxelMm, isObstacle, voxelMm);
+    };
+    mount::DepthRaster stillFar = raster(true), movingFar = raster(false);
+    if (!isTouching) {
+        for (size_t i = 0; i < still.voxels.size(); ++i)
+            stillFar.addPoint(still.voxels[i], 0.5 * voxelMm, uint32_t(i));
+        for (size_t i = 0; i < moving.voxels.size(); ++i)
+            movingFar.addPoint(moving.voxels[i], 0.0, uint32_t(i));
+        return mount::worstHit(stillFar, movingFar, voxelMm).isHit;
+    }
+    // Each voxel drawn into its parts: near the face, or not (far), and among those not, away from it.
+    mount::DepthRaster stillAway = raster(true), stillNear = raster(true);
+    mount::DepthRaster movingAway = raster(false), movingNear = raster(false);
+    auto draw = [&](const MountBody& body, const MountBody& other, double radiusMm, mount::DepthRaster& near,
+                    mount::DepthRaster& far, mount::DepthRaster& away) {
+        for (size_t i = 0; i < body.voxels.size(); ++i) {
+            if (body.isNearCutWith(i, other)) {
+                near.addPoint(body.voxels[i], radiusMm, uint32_t(i));
+                continue;
+            }
+            far.addPoint(body.voxels[i], radiusMm, uint32_t(i));
+            if (!body.isNearCutWith(i, other, kWideCutLayers))
+                away.addPoint(body.voxels[i], radiusMm, uint32_t(i));
+        }
+    };
+    draw(still, moving, 0.5 * voxelMm, stillNear, stillFar, stillAway);
+    draw(moving, still, 0.0, movingNear, movingFar, movingAway);
+    return mount::worstHit(stillFar, movingFar, voxelMm).isHit ||
+           mount::worstHit(stillAway, movingNear, voxelMm).isHit ||
+           mount::worstHit(stillNear, movingAway, voxelMm).isHit;
 }
 
 /// Whether the cut faces between @p still and @p moving let @p moving go on after @p still along

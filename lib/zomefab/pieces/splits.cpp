@@ -123,6 +123,7 @@ MountBody halfBody(const VoxelGraph& g, const std::vector<uint8_t>& side, uint8_
         if (!isSurface) continue;
         half.voxels.push_back((*g.voxels)[v]);
         half.nearCutOf.push_back({kNone, kNone});
+        half.cutLayer.push_back({0, 0});
         half.bounds.expand((*g.voxels)[v]);
     }
     half.options = rankedOptions(halfCandidates(candidates, plane, which, s), size_t(s.maxPerPiece));

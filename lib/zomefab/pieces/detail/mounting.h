@@ -29,6 +29,14 @@ namespace zomefab::pieces::detail {
 /// normal. Their voxels take part in the sweeps between the two instead (a voxel of tolerance).
 inline constexpr size_t kMinOrderFaceVoxels = 50;
 
+/// Voxel layers from a cut face (6-neighbours inward, the face's own voxels the first) that count as
+/// near it: two neighbours' voxels this near their face are not swept against each other (the face
+/// orders them); voxels this near are swept against the other's voxels beyond kWideCutLayers, which
+/// may reach round the face's end. The wider band keeps a seam along a diagonal plane, whose layers
+/// are thinner (1/√3 voxel), from meeting the layers just behind the other side.
+inline constexpr uint8_t kNearCutLayers = 2;
+inline constexpr uint8_t kWideCutLayers = 4;
+
 /// A glued group has at most this many pieces: a maker glues a few pieces together, not half the
 /// object (what more gluing would resolve is re-cut instead).
 inline constexpr size_t kMaxGluedPieces = 4;
@@ -49,14 +57,16 @@ struct DirectionOption {
 struct MountBody {
     std::vector<uint32_t> pieces;  ///< sorted; the first is the body's name
     std::vector<Vec3d> voxels;
-    /// Per voxel: the pieces whose cut face with this body's piece lies within two voxels (up to
-    /// two, kNone for none). Left out of the sweep against a body holding such a piece, whose order
-    /// that face decides; against every other body it is swept like any voxel (the dino at 350 mm:
-    /// a piece's rim along its cut with a third piece, left out of every sweep, hid 25.6 mm of it
-    /// in a neighbour's path).
+    /// Per voxel: the pieces whose cut face with this body's piece lies within kWideCutLayers
+    /// voxels (up to two, kNone for none), and cutLayer how near each (1: on the face).
+    /// A voxel within kNearCutLayers is left out of the sweep against a body holding such a piece,
+    /// whose order that face decides; against every other body it is swept like any voxel (the dino
+    /// at 350 mm: a piece's rim along its cut with a third piece, left out of every sweep, hid
+    /// 25.6 mm of it in a neighbour's path).
     std::vector<std::array<uint32_t, 2>> nearCutOf;
-    /// Whether voxel @p i lies near a cut face with one of @p other's pieces.
-    bool isNearCutWith(size_t i, const MountBody& other) const;
+    std::vector<std::array<uint8_t, 2>> cutLayer;
+    /// Whether voxel @p i lies within @p layers of a cut face with one of @p other's pieces.
+    bool isNearCutWith(size_t i, const MountBody& other, uint8_t layers = kNearCutLayers) const;
     Box3d bounds;
     std::vector<DirectionOption> options;
     /// For a body no peg can hold (no free direction with a tenon), or one the order leaves stuck:
