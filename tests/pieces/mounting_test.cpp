@@ -51,6 +51,22 @@ void nearEachOther(MountBody& a, MountBody& b) {
         }
 }
 
+/// Marks the voxels of @p m where @p isNear holds as @p layer layers from its cut face with piece
+/// @p other (1: on it), as the planner marks them.
+template <class IsNear>
+void markNear(MountBody& m, uint32_t other, IsNear isNear, uint8_t layer = 1) {
+    for (size_t i = 0; i < m.voxels.size(); ++i)
+        if (isNear(m.voxels[i])) m.nearCutOf[i][0] = other, m.cutLayer[i][0] = layer;
+}
+
+/// Adds @p part (an arm of the same piece) to @p body.
+void addPart(MountBody& body, const MountBody& part) {
+    body.voxels.insert(body.voxels.end(), part.voxels.begin(), part.voxels.end());
+    body.nearCutOf.insert(body.nearCutOf.end(), part.nearCutOf.begin(), part.nearCutOf.end());
+    body.cutLayer.insert(body.cutLayer.end(), part.cutLayer.begin(), part.cutLayer.end());
+    body.bounds.expand(part.bounds.min), body.bounds.expand(part.bounds.max);
+}
+
 /// A direction the body could take: free of the frame, with @p tenons tenons.
 DirectionOption option(int hole, size_t tenons) {
     DirectionOption o;
@@ -202,18 +218,11 @@ TEST_CASE("mounting: a voxel near one neighbour's seam is still swept against th
     MountBody a = slab(0, 0, 10, 0, 10), c = slab(2, 11, 21, 0, 10), arm = slab(2, 0, 21, 20, 21),
               d = slab(3, 0, 10, 22, 25);
     // Two voxels deep on each side of a seam, as the planner marks them.
-    auto markNear = [](MountBody& m, uint32_t other, auto isNear) {
-        for (size_t i = 0; i < m.voxels.size(); ++i)
-            if (isNear(m.voxels[i])) m.nearCutOf[i][0] = other, m.cutLayer[i][0] = 1;
-    };
     markNear(a, 2, [](const Vec3d& x) { return x[0] >= 9; });
     markNear(c, 0, [](const Vec3d& x) { return x[0] <= 12; });
     markNear(arm, 3, [](const Vec3d&) { return true; });  // the arm is two voxels thick
     markNear(d, 2, [](const Vec3d& x) { return x[2] <= 23; });
-    c.voxels.insert(c.voxels.end(), arm.voxels.begin(), arm.voxels.end());
-    c.nearCutOf.insert(c.nearCutOf.end(), arm.nearCutOf.begin(), arm.nearCutOf.end());
-    c.cutLayer.insert(c.cutLayer.end(), arm.cutLayer.begin(), arm.cutLayer.end());
-    c.bounds.expand(arm.bounds.min), c.bounds.expand(arm.bounds.max);
+    addPart(c, arm);
     const FaceContacts faces = {{{0, 2}, {CutContact{{1, 0, 0}, 121}}},
                                 {{2, 3}, {CutContact{{0, 0, 1}, 121}}}};
     a.options = {option(kUp, 2)};
@@ -232,16 +241,9 @@ TEST_CASE("mounting: a voxel near a seam is swept against the neighbour's voxels
     // before C. (With A's near-seam voxels left out of every sweep against C, as once, A went on
     // last and ran into the arm: a 400 mm cube with a tunnel, 11.6 mm into a neighbour.)
     MountBody a = slab(0, 0, 10, 0, 10), c = slab(2, 11, 21, 0, 10), arm = slab(2, 9, 21, 14, 15);
-    auto markNear = [](MountBody& m, uint32_t other, auto isNear, uint8_t layer = 1) {
-        for (size_t i = 0; i < m.voxels.size(); ++i)
-            if (isNear(m.voxels[i])) m.nearCutOf[i][0] = other, m.cutLayer[i][0] = layer;
-    };
     markNear(a, 2, [](const Vec3d& x) { return x[0] >= 9; });
     markNear(c, 0, [](const Vec3d& x) { return x[0] <= 12; });
-    c.voxels.insert(c.voxels.end(), arm.voxels.begin(), arm.voxels.end());
-    c.nearCutOf.insert(c.nearCutOf.end(), arm.nearCutOf.begin(), arm.nearCutOf.end());
-    c.cutLayer.insert(c.cutLayer.end(), arm.cutLayer.begin(), arm.cutLayer.end());
-    c.bounds.expand(arm.bounds.min), c.bounds.expand(arm.bounds.max);
+    addPart(c, arm);
     const FaceContacts faces = {{{0, 2}, {CutContact{{1, 0, 0}, 121}}}};
     a.options = {option(kUp, 2)};
     c.options = {option(kRight, 2)};

@@ -84,12 +84,13 @@ bool FrameSweeps::isFree(const MountBody& body, int hole, double voxelMm, std::s
     return !hit.isHit;
 }
 
-bool MountBody::isNearCutWith(size_t i, const MountBody& other, uint8_t layers) const {
+uint8_t MountBody::cutLayerWith(size_t i, const MountBody& other) const {
+    uint8_t nearest = 0;
     for (size_t k = 0; k < 2; ++k)
-        if (nearCutOf[i][k] != kNone && cutLayer[i][k] <= layers &&
+        if (nearCutOf[i][k] != kNone && (nearest == 0 || cutLayer[i][k] < nearest) &&
             std::find(other.pieces.begin(), other.pieces.end(), nearCutOf[i][k]) != other.pieces.end())
-            return true;
-    return false;
+            nearest = cutLayer[i][k];
+    return nearest;
 }
 
 PlannerInput plannerInput(const Pieces& out, const VoxelField& field,

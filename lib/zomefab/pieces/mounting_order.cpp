@@ -68,13 +68,13 @@ bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, 
     auto draw = [&](const MountBody& body, const MountBody& other, double radiusMm, mount::DepthRaster& near,
                     mount::DepthRaster& far, mount::DepthRaster& away) {
         for (size_t i = 0; i < body.voxels.size(); ++i) {
-            if (body.isNearCutWith(i, other)) {
+            const uint8_t layer = body.cutLayerWith(i, other);  // 0: within kWideCutLayers of no face
+            if (layer != 0 && layer <= kNearCutLayers) {
                 near.addPoint(body.voxels[i], radiusMm, uint32_t(i));
                 continue;
             }
             far.addPoint(body.voxels[i], radiusMm, uint32_t(i));
-            if (!body.isNearCutWith(i, other, kWideCutLayers))
-                away.addPoint(body.voxels[i], radiusMm, uint32_t(i));
+            if (layer == 0) away.addPoint(body.voxels[i], radiusMm, uint32_t(i));
         }
     };
     draw(still, moving, 0.5 * voxelMm, stillNear, stillFar, stillAway);

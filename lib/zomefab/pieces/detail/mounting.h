@@ -65,8 +65,9 @@ struct MountBody {
     /// 25.6 mm of it in a neighbour's path).
     std::vector<std::array<uint32_t, 2>> nearCutOf;
     std::vector<std::array<uint8_t, 2>> cutLayer;
-    /// Whether voxel @p i lies within @p layers of a cut face with one of @p other's pieces.
-    bool isNearCutWith(size_t i, const MountBody& other, uint8_t layers = kNearCutLayers) const;
+    /// How many layers voxel @p i lies from its nearest cut face with one of @p other's pieces
+    /// (1: on it), 0 when it is within kWideCutLayers of none.
+    uint8_t cutLayerWith(size_t i, const MountBody& other) const;
     Box3d bounds;
     std::vector<DirectionOption> options;
     /// For a body no peg can hold (no free direction with a tenon), or one the order leaves stuck:
