@@ -59,14 +59,6 @@ void markNear(MountBody& m, uint32_t other, IsNear isNear, uint8_t layer = 1) {
         if (isNear(m.voxels[i])) m.nearCutOf[i][0] = other, m.cutLayer[i][0] = layer;
 }
 
-/// Adds @p part (an arm of the same piece) to @p body.
-void addPart(MountBody& body, const MountBody& part) {
-    body.voxels.insert(body.voxels.end(), part.voxels.begin(), part.voxels.end());
-    body.nearCutOf.insert(body.nearCutOf.end(), part.nearCutOf.begin(), part.nearCutOf.end());
-    body.cutLayer.insert(body.cutLayer.end(), part.cutLayer.begin(), part.cutLayer.end());
-    body.bounds.expand(part.bounds.min), body.bounds.expand(part.bounds.max);
-}
-
 /// A direction the body could take: free of the frame, with @p tenons tenons.
 DirectionOption option(int hole, size_t tenons) {
     DirectionOption o;
@@ -222,7 +214,7 @@ TEST_CASE("mounting: a voxel near one neighbour's seam is still swept against th
     markNear(c, 0, [](const Vec3d& x) { return x[0] <= 12; });
     markNear(arm, 3, [](const Vec3d&) { return true; });  // the arm is two voxels thick
     markNear(d, 2, [](const Vec3d& x) { return x[2] <= 23; });
-    addPart(c, arm);
+    c.addVoxelsOf(arm);  // an arm of the same piece
     const FaceContacts faces = {{{0, 2}, {CutContact{{1, 0, 0}, 121}}},
                                 {{2, 3}, {CutContact{{0, 0, 1}, 121}}}};
     a.options = {option(kUp, 2)};
@@ -243,7 +235,7 @@ TEST_CASE("mounting: a voxel near a seam is swept against the neighbour's voxels
     MountBody a = slab(0, 0, 10, 0, 10), c = slab(2, 11, 21, 0, 10), arm = slab(2, 9, 21, 14, 15);
     markNear(a, 2, [](const Vec3d& x) { return x[0] >= 9; });
     markNear(c, 0, [](const Vec3d& x) { return x[0] <= 12; });
-    addPart(c, arm);
+    c.addVoxelsOf(arm);  // an arm of the same piece
     const FaceContacts faces = {{{0, 2}, {CutContact{{1, 0, 0}, 121}}}};
     a.options = {option(kUp, 2)};
     c.options = {option(kRight, 2)};

@@ -93,6 +93,13 @@ uint8_t MountBody::cutLayerWith(size_t i, const MountBody& other) const {
     return nearest;
 }
 
+void MountBody::addVoxelsOf(const MountBody& part) {
+    voxels.insert(voxels.end(), part.voxels.begin(), part.voxels.end());
+    nearCutOf.insert(nearCutOf.end(), part.nearCutOf.begin(), part.nearCutOf.end());
+    cutLayer.insert(cutLayer.end(), part.cutLayer.begin(), part.cutLayer.end());
+    bounds.expand(part.bounds.min), bounds.expand(part.bounds.max);
+}
+
 PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
                           const std::vector<TenonCandidate>& candidates) {
     const size_t n = out.pieces.size();
@@ -227,11 +234,7 @@ MountBody makeBody(const std::vector<uint32_t>& members, const PlannerInput& inp
     std::sort(body.pieces.begin(), body.pieces.end());
     std::map<int, std::pair<size_t, double>> byHole;
     for (uint32_t p : body.pieces) {
-        const MountBody& piece = input.pieces[p];
-        body.voxels.insert(body.voxels.end(), piece.voxels.begin(), piece.voxels.end());
-        body.nearCutOf.insert(body.nearCutOf.end(), piece.nearCutOf.begin(), piece.nearCutOf.end());
-        body.cutLayer.insert(body.cutLayer.end(), piece.cutLayer.begin(), piece.cutLayer.end());
-        body.bounds.expand(piece.bounds.min), body.bounds.expand(piece.bounds.max);
+        body.addVoxelsOf(input.pieces[p]);
         for (const auto& [hole, entry] : input.candidatesByHole[p]) {
             byHole[hole].first += entry.first;
             byHole[hole].second += entry.second;

@@ -68,6 +68,8 @@ struct MountBody {
     /// How many layers voxel @p i lies from its nearest cut face with one of @p other's pieces
     /// (1: on it), 0 when it is within kWideCutLayers of none.
     uint8_t cutLayerWith(size_t i, const MountBody& other) const;
+    /// Adds @p part's voxels with their cut-face marks, and its bounds (a member of a glued body).
+    void addVoxelsOf(const MountBody& part);
     Box3d bounds;
     std::vector<DirectionOption> options;
     /// For a body no peg can hold (no free direction with a tenon), or one the order leaves stuck:
