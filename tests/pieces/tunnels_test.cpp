@@ -56,3 +56,16 @@ TEST_CASE("slabOffsets: planes at the multiples of the slab length, none that le
     CHECK(slabOffsets({}, 80.0, 1).empty());
     CHECK(slabOffsets(t, 0.0, 1).empty());
 }
+
+TEST_CASE(
+    "tunnelGroups: the axis most pieces are free along both ways wins, not the one most reach one way") {
+    // 0, 1: the lining, free along ±x; 2–5: pieces outside, free outward along a diagonal only
+    // (0 and 1 too: the diagonal leaves the tunnel's mouth).
+    const Vec3d diag = normalized(Vec3d{1, 1, -1});
+    const std::vector<std::vector<Vec3d>> free{
+        {kX, kMinusX, diag}, {kX, kMinusX, diag, scale(diag, -1.0)}, {diag}, {diag}, {diag}, {diag}};
+    const std::vector<TunnelGroup> groups = tunnelGroups({0, 1, 2, 3, 4, 5}, free, 1);
+    REQUIRE(!groups.empty());
+    CHECK(std::abs(groups[0].axis[0]) > 0.99);
+    CHECK(groups[0].pieces == std::vector<uint32_t>{0, 1});
+}

@@ -26,7 +26,8 @@ struct TunnelGroup {
 /// (unit). An axis is a tunnel's when at least @p minPieces pieces are free along it both ways (a
 /// tunnel open at both ends; along a limb the pieces are free outward only), and it takes every
 /// piece free along it either way (a piece that reaches round a tunnel's mouth is free outward
-/// only); the axis with the most pieces first, then the next among the rest. Directions within 1°
+/// only); the axis with the most pieces free along it both ways first (then the most pieces), then
+/// the next among the rest. Directions within 1°
 /// are one. Deterministic (ties: the first direction met).
 std::vector<TunnelGroup> tunnelGroups(const std::vector<uint32_t>& pieces,
                                       const std::vector<std::vector<Vec3d>>& freeAlong, size_t minPieces = 2);
