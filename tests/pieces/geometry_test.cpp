@@ -609,6 +609,25 @@ TEST_CASE("orientation: support decides: a shelf piece lies on its flat top, not
     CHECK(estimateSupport(table, {0, 0, -1}).volumeMm3 == doctest::Approx(50 * 60 * 40).epsilon(0.05));
 }
 
+TEST_CASE(
+    "support: an underside 50° from the vertical needs it at the 45° rule, not on a printer that takes 60°") {
+    // A prism 20 mm long along y; its section in xz: A (0, 0), B (11.92, 10), C (0, 10). The face
+    // A–B faces down and out, 50° from the vertical (its normal 40° from straight down).
+    const double run = 10.0 * std::tan(50.0 * std::acos(-1.0) / 180.0);
+    TriMesh prism;
+    for (double y : {0.0, 20.0})
+        for (const auto& [x, z] : {std::pair{0.0, 0.0}, std::pair{run, 10.0}, std::pair{0.0, 10.0}})
+            prism.positions.push_back(Vec3f{float(x), float(y), float(z)});
+    const uint32_t A = 0, B = 1, C = 2, A2 = 3, B2 = 4, C2 = 5;  // the same three at y = 20
+    prism.triangles = {{A, B, C},  {A2, C2, B2}, {A, B2, B}, {A, A2, B2},
+                       {C, B, B2}, {C, B2, C2},  {A, C, C2}, {A, C2, A2}};
+    const double underside = std::hypot(run, 10.0) * 20.0;
+    CHECK(estimateSupport(prism, {0, 0, -1}).areaMm2 == doctest::Approx(underside));
+    CHECK(estimateSupport(prism, {0, 0, -1}, 45.0).volumeMm3 > 0.0);
+    CHECK(estimateSupport(prism, {0, 0, -1}, 55.0).areaMm2 == 0.0);
+    CHECK(estimateSupport(prism, {0, 0, -1}, 55.0).volumeMm3 == 0.0);
+}
+
 TEST_CASE("label: seven-segment strokes, an underline, centred") {
     LabelOptions o;
     const auto eight = labelStrokes("8", o);

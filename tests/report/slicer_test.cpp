@@ -80,6 +80,16 @@ TEST_CASE("slicer: the command line follows print-estimates.md and refuses nothi
     s.infillPercent = 100;
     // "The selected fill pattern is not supposed to work at 100% density": rectilinear instead.
     CHECK(valueOf(prusaSlicerArguments(s), "--fill-pattern") == "rectilinear");
+    // Supports: at the 45° rule PrusaSlicer keeps its automatic threshold; a printer that takes
+    // 60° overhangs gets PrusaSlicer's threshold of 30° from the horizontal.
+    s.supports = true;
+    CHECK(valueOf(prusaSlicerArguments(s), "--support-material-threshold") == "<missing>");
+    s.overhangDeg = 60.0;
+    CHECK(valueOf(prusaSlicerArguments(s), "--support-material-threshold") == "30");
+    s.supports = false;
+    CHECK(valueOf(prusaSlicerArguments(s), "--support-material-threshold") == "<missing>");
+    s.overhangDeg = 85.0;
+    CHECK_THROWS(s.validate());
 }
 
 TEST_CASE("slicer: a missing slicer is a processing error naming it") {

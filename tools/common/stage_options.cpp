@@ -80,6 +80,10 @@ void FabricationCli::addTo(CLI::App& app, unsigned parts) {
                        "Free border on every side of the bed (mm): every piece fits the bed less it, "
                        "room for the slicer's supports and a skirt")
             ->capture_default_str();
+        app.add_option("--overhang-deg", f.overhangDeg,
+                       "Steepest overhang the printer prints without support, degrees from the vertical "
+                       "(pieces' orientation and every print's supports in the cost report)")
+            ->capture_default_str();
     }
     if (parts & kWall)
         app.add_option("--shell-mm", f.wallMm,

@@ -50,6 +50,7 @@ void checkFabrication(const Fabrication& f) {
     requireRange(f.frameClearanceMm, 0.0, 1000.0, "--frame-clearance-mm", "mm");
     requireRange(f.wallGapMm, 0.0, 100.0, "--wall-gap-mm", "mm");
     requireRange(f.b0Mm, 1.0, 1000.0, "--b0-mm", "mm");
+    requireRange(f.overhangDeg, 10.0, 80.0, "--overhang-deg", "degrees");
 }
 
 bool boxFitsPrinter(const Vec3d& sizeMm, const Vec3d& printerMm, double marginMm, double toleranceMm) {

@@ -34,6 +34,11 @@ struct Fabrication {
     /// Air between the shell's inner wall and the frame, mm: a piece pushed onto the frame slides
     /// past balls and struts, so the frame keeps at least wall + gap from the outer surface.
     double wallGapMm = 3.0;
+    /// The steepest overhang the printer prints without support, degrees from the vertical (the
+    /// usual 45° rule). The pieces' orientation and the cost report's supports (estimator and
+    /// slicer, for the pieces, the octree parts and the object printed whole alike) use it; at 45
+    /// PrusaSlicer keeps its automatic threshold, otherwise it gets 90 − this from the horizontal.
+    double overhangDeg = 45.0;
     /// Centre-to-centre length of the B0 strut, mm (paper §4.2: b0 = 47.3 measured; vZome's
     /// nominal 46.27). It sets the whole kit's scale and d_max = b0 of the forbidden zone.
     double b0Mm = 47.3;

@@ -62,7 +62,7 @@ void flattenBase(TriMesh& mesh, const std::vector<CutFace>& faces, const PrintOr
 }  // namespace
 
 std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, const CellSet& set,
-                        const Vec3d& printerMm, double bedMarginMm, double voxel, double seamGapMm,
+                        const Fabrication& fabrication, double voxel, double seamGapMm,
                         const RunContext& context) {
     // Sealed pockets of a few voxels (seen up to 28 voxels, where a tenon prism meets a tilted
     // wall) would be printed as empty pockets and make admesh count extra parts: fill them. An
@@ -82,8 +82,10 @@ std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, cons
     piece.gridBoundsMm = boundingBox(mesh);
     const std::vector<CutFace> faces = measureCutFaces(mesh, cutPlanes(cells, set, seamGapMm), 0.05 * voxel);
     // Oriented within the bed less its margins, then centred on the bed.
-    const Vec3d box = pieceBoxMm(printerMm, bedMarginMm);
-    PrintOrientation orientation = orientForPrinter(mesh, faces, box);
+    const Vec3d box = fabrication.pieceBoxMm();
+    const double bedMarginMm = fabrication.bedMarginMm;
+    PrintOrientation orientation =
+        orientForPrinter(mesh, faces, box, kFlatToleranceMm, fabrication.overhangDeg);
     if (!orientation.fits) failFit(piece, orientation, box);
     orientation.transformMm.m[3] += bedMarginMm;
     orientation.transformMm.m[7] += bedMarginMm;

@@ -162,8 +162,8 @@ constexpr double kCutFaceSupportSlackMm3 = 2000.0;
 class OrientationSearch {
 public:
     OrientationSearch(const TriMesh& meshMm, const std::vector<CutFace>& cutFaces, const Vec3d& printer,
-                      double flatToleranceMm)
-        : mesh(meshMm), cutFaces(cutFaces), printer(printer), flatToleranceMm(flatToleranceMm) {
+                      double flatToleranceMm, double overhangDeg)
+        : mesh(meshMm, overhangDeg), cutFaces(cutFaces), printer(printer), flatToleranceMm(flatToleranceMm) {
         for (const CutFace& f : cutFaces) directions.push_back(f.outwardNormal);
         for (const Vec3d& d : facetDirections(mesh)) directions.push_back(d);
         searchStart = directions.size();
@@ -362,10 +362,10 @@ double baseAreaMm2(const TriMesh& mesh, const Vec3d& down, double heightMm) {
 }
 
 PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFace>& cutFaces,
-                                  const Vec3d& printer, double flatToleranceMm) {
+                                  const Vec3d& printer, double flatToleranceMm, double overhangDeg) {
     PrintOrientation out;
     if (meshMm.positions.empty()) return out;
-    OrientationSearch search(meshMm, cutFaces, printer, flatToleranceMm);
+    OrientationSearch search(meshMm, cutFaces, printer, flatToleranceMm, overhangDeg);
     search.findFlatBase();
     search.findResting();
     // A cut face wins unless resting elsewhere scores clearly better: a flat first layer is worth

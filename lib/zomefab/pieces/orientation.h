@@ -45,22 +45,23 @@ constexpr double kMinCutFaceAreaMm2 = 100.0;
 double baseAreaMm2(const TriMesh& meshMm, const Vec3d& down, double heightMm = kBaseHeightMm);
 
 /// A facet facing down more steeply than this from the vertical needs support (the usual 45° rule;
-/// PrusaSlicer's automatic threshold at 0.3 mm layers is close to it).
+/// PrusaSlicer's automatic threshold at 0.3 mm layers is close to it): Fabrication::overhangDeg's
+/// default, and the functions' below.
 constexpr double kOverhangDeg = 45.0;
 /// A piece whose first layer is smaller than this is advised a brim (about a 20 × 20 mm base).
 constexpr double kBrimBelowMm2 = 400.0;
 
 /// What would need support were @p down (unit, the mesh's frame) to point down.
 struct SupportEstimate {
-    /// Facets facing down more steeply than kOverhangDeg from the vertical and above the first
-    /// layer: their area, mm².
+    /// Facets facing down more steeply than the overhang (kOverhangDeg unless given) from the
+    /// vertical and above the first layer: their area, mm².
     double areaMm2 = 0.0;
     /// The volume support columns under those facets fill, each from the first up-facing surface
     /// of the piece below it or from the bed (a slicer builds supports on the model too), sampled
     /// on a 2 mm grid, mm³. Solid: a slicer's sparse support uses a fraction of it.
     double volumeMm3 = 0.0;
 };
-SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down);
+SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down, double overhangDeg = kOverhangDeg);
 
 /// How a piece sits in the printer.
 struct PrintOrientation {
@@ -86,8 +87,11 @@ struct PrintOrientation {
 /// penalty for a first layer under kBrimBelowMm2; the best 8 resting directions are tilted in
 /// small steps towards less support. A cut face wins unless a resting direction scores clearly
 /// better (by 10 % and 2 cm³). When no direction has the first layer, the largest contact that
-/// fits; when nothing fits, the orientation with the most room, fits = false. Deterministic.
+/// fits; when nothing fits, the orientation with the most room, fits = false. Support is what
+/// overhangs more than @p overhangDeg from the vertical needs (Fabrication::overhangDeg).
+/// Deterministic.
 PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFace>& cutFaces,
-                                  const Vec3d& printerMm, double flatToleranceMm = kFlatToleranceMm);
+                                  const Vec3d& printerMm, double flatToleranceMm = kFlatToleranceMm,
+                                  double overhangDeg = kOverhangDeg);
 
 }  // namespace zomefab::pieces

@@ -113,7 +113,8 @@ std::vector<PieceGrid> pieceGrids(const Pieces& out, const VoxelField& field, co
 
 /// Step 5 for every piece, in parallel: mesh, checks, orientation.
 void meshPieces(Pieces& out, std::vector<PieceGrid>& grids, const GridCells& cells,
-                const std::vector<CellSet>& cellSets, const RunContext& context) {
+                const std::vector<CellSet>& cellSets, const Fabrication& fabrication,
+                const RunContext& context) {
     const size_t pieceCount = out.pieces.size();
     const double voxel = out.voxelMm;
     // Not OpenVDB's fracture scheme (VolumeToMesh::setRefGrid): it snaps the seam vertices to the
@@ -134,8 +135,8 @@ void meshPieces(Pieces& out, std::vector<PieceGrid>& grids, const GridCells& cel
                 grids[p] = PieceGrid();
                 // The pegs as exact meshes, overlapping the meshed prisms (tenons.h, pegMesh).
                 for (const Tenon& t : out.pieces[p].tenons) appendMesh(mesh, pegMesh(t, out.options.tenons));
-                notes[p] = finishPiece(out.pieces[p], std::move(mesh), cells, cellSets[p], out.printerMm,
-                                       out.bedMarginMm, voxel, out.options.seamGapMm, context);
+                notes[p] = finishPiece(out.pieces[p], std::move(mesh), cells, cellSets[p], fabrication, voxel,
+                                       out.options.seamGapMm, context);
                 context.progress("pieces", 0.5 + 0.45 * double(++meshed) / double(pieceCount));
             }
         });
@@ -257,7 +258,7 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
     std::vector<PieceGrid> grids = pieceGrids(out, field, cells, grouping.cellSets, *shell, context);
     context.debug("level sets: " + formatNumber(clock.seconds(), 3) + " s");
     field = VoxelField();  // the grids hold what meshing needs
-    meshPieces(out, grids, cells, grouping.cellSets, context);
+    meshPieces(out, grids, cells, grouping.cellSets, fabrication, context);
     out.seconds = clock.seconds();
     context.debug("meshed, checked and oriented: " + formatNumber(out.seconds, 3) + " s");
     return out;

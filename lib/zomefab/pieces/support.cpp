@@ -140,12 +140,11 @@ double lowestAlong(const MeshD& m, const Vec3d& up) {
 
 namespace {
 
-/// A facet of vector area @p vectorArea faces down (along unit @p down) more steeply than
-/// kOverhangDeg from the vertical: it needs support.
-bool isOverhang(const Vec3d& vectorArea, const Vec3d& down) {
-    static const double threshold = std::sin(kOverhangDeg * kPi / 180.0);
+/// A facet of vector area @p vectorArea faces down (along unit @p down) more steeply than the
+/// printer's overhang (@p overhangSin, MeshD) from the vertical: it needs support.
+bool isOverhang(const Vec3d& vectorArea, const Vec3d& down, double overhangSin) {
     const double area = norm(vectorArea);
-    return area > 0 && dot(vectorArea, down) > threshold * area;
+    return area > 0 && dot(vectorArea, down) > overhangSin * area;
 }
 
 }  // namespace
@@ -155,7 +154,7 @@ SupportEstimate supportOf(const MeshD& m, const Vec3d& down) {
     const double lowest = lowestAlong(m, up);
     SupportEstimate out;
     for (size_t i = 0; i < m.triangles.size(); ++i) {
-        if (!isOverhang(m.vectorArea[i], down)) continue;
+        if (!isOverhang(m.vectorArea[i], down, m.overhangSin)) continue;
         const Triangle& t = m.triangles[i];
         const double h =
             (dot(up, m.points[t[0]]) + dot(up, m.points[t[1]]) + dot(up, m.points[t[2]])) / 3.0 - lowest;
@@ -209,7 +208,7 @@ double supportColumnsMm3(const MeshD& m, const Vec3d& down) {
     std::sort(floors.begin(), floors.end());
     double volume = 0.0;
     for (size_t k = 0; k < m.triangles.size(); ++k) {
-        if (!isOverhang(m.vectorArea[k], down)) continue;
+        if (!isOverhang(m.vectorArea[k], down, m.overhangSin)) continue;
         forCells(m.triangles[k], [&](uint64_t cell, double z) {
             if (z - z0 <= kBaseHeightMm) return;
             // The highest floor in this cell below the overhang (half a cell of slack for the
@@ -230,8 +229,8 @@ SupportEstimate estimateSupport(const MeshD& m, const Vec3d& down) {
 
 }  // namespace detail
 
-SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down) {
-    return detail::estimateSupport(MeshD(meshMm), normalized(down));
+SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down, double overhangDeg) {
+    return detail::estimateSupport(MeshD(meshMm, overhangDeg), normalized(down));
 }
 
 }  // namespace zomefab::pieces

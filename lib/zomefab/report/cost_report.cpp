@@ -72,6 +72,7 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<const TriMesh*>
     CostReport report;
     report.printerMm = fabrication.printerMm;
     report.options = options;
+    report.options.print.overhangDeg = fabrication.overhangDeg;  // the printer's, for every part
     report.source = options.source;
     report.parts = parts;
     report.pieceCount = piecesMm.size();
@@ -121,6 +122,7 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<const TriMesh*>
         PrintSettings settings = options.print;
         settings.infillPercent = infill;
         settings.supports = options.countSupports;
+        settings.overhangDeg = report.options.print.overhangDeg;
         settings.validate();
         CostCase c;
         c.name = name;
@@ -172,6 +174,7 @@ nlohmann::json costReportToJson(const CostReport& r) {
               {"layer_height_mm", o.print.layerHeightMm},
               {"first_layer_height_mm", o.print.firstLayerHeightMm},
               {"nozzle_mm", o.print.nozzleMm},
+              {"overhang_deg", o.print.overhangDeg},
               {"extrusion_width_mm", o.print.extrusionWidthMm},
               {"perimeters", o.print.perimeters},
               {"top_layers", o.print.topLayers},
@@ -229,12 +232,12 @@ std::string costReportMarkdown(const CostReport& r) {
     if (r.options.countSupports && !r.cases.empty()) {
         const CostCase& c = r.cases[0];
         md += formatNumbers(
-            " Automatic supports are counted on every side, where each part's overhangs (steeper than 45°) "
-            "need "
+            " Automatic supports are counted on every side, where each part's overhangs (steeper than %.0f° "
+            "from the vertical, `--overhang-deg`) need "
             "them: %.0f cm³ for the pieces, %.0f cm³ for the octree parts, %.0f cm³ for the object printed "
             "whole.",
-            c.zomefab.print.supportMm3 / 1000.0, c.baseline.print.supportMm3 / 1000.0,
-            c.whole.print.supportMm3 / 1000.0);
+            r.options.print.overhangDeg, c.zomefab.print.supportMm3 / 1000.0,
+            c.baseline.print.supportMm3 / 1000.0, c.whole.print.supportMm3 / 1000.0);
     }
     md += "\n";
     return md;

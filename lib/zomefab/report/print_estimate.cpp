@@ -35,6 +35,9 @@ void PrintSettings::validate() const {
     if (!(infillPercent > 0.0 && infillPercent <= 100.0))
         throw Error(ErrorCode::Usage,
                     "infill must be in (0, 100] percent, got " + std::to_string(infillPercent));
+    if (!(overhangDeg >= 10.0 && overhangDeg <= 80.0))
+        throw Error(ErrorCode::Usage,
+                    "the overhang must be in [10, 80] degrees, got " + std::to_string(overhangDeg));
 }
 
 void FilamentOptions::validate() const {
@@ -129,7 +132,8 @@ PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const P
     e.seconds = e.perimeterMm3 * rates.perimeterSPerMm3 + e.solidMm3 * rates.solidSPerMm3 +
                 e.infillMm3 * (isSolid ? rates.solidInfillSPerMm3 : rates.sparseInfillSPerMm3);
     if (s.supports) {
-        e.supportMm3 = rates.supportShare * pieces::estimateSupport(part, {0, 0, -1}).volumeMm3;
+        e.supportMm3 =
+            rates.supportShare * pieces::estimateSupport(part, {0, 0, -1}, s.overhangDeg).volumeMm3;
         e.filamentMm3 += e.supportMm3;
         e.seconds += e.supportMm3 * rates.supportSPerMm3;
     }

@@ -30,6 +30,11 @@ struct PrintSettings {
     /// --support-material-auto; the estimator: PrintRates::supportShare of the columns under the
     /// facets steeper than 45°, pieces::estimateSupport).
     bool supports = false;
+    /// The steepest overhang printed without support, degrees from the vertical: the printer's
+    /// (Fabrication::overhangDeg; costReport sets it). The estimator supports what is steeper; at
+    /// 45 PrusaSlicer keeps its automatic threshold, otherwise it gets
+    /// --support-material-threshold 90 − this (its threshold is measured from the horizontal).
+    double overhangDeg = 45.0;
 
     /// @throw Error(Usage) naming the option for non-positive sizes or infill outside (0, 100].
     void validate() const;

@@ -235,9 +235,12 @@ std::string perPieceMarkdown(const RunRecord& run) {
                   "on 19 pieces: +5 %% in all, each within 53 %%, docs/report.md)",
                   100 * run.cost.options.rates.supportShare);
     std::string md = "\n## Per piece\n\nEach piece's print on its own, " + supportNote +
-                     ". Overhang: the area facing down more than 45° from the vertical as the piece lies. "
-                     "Brim: the first layer is under 4 cm².\n\n| piece | plate |" +
-                     columns + " overhang cm² | support g | brim |\n|---|---:|" + rule + "---:|---:|---|\n";
+                     formatNumbers(
+                         ". Overhang: the area facing down more than %.0f° from the vertical as the "
+                         "piece lies. ",
+                         run.cost.options.print.overhangDeg) +
+                     "Brim: the first layer is under 4 cm².\n\n| piece | plate |" + columns +
+                     " overhang cm² | support g | brim |\n|---|---:|" + rule + "---:|---:|---|\n";
     double supportG = 0;
     for (size_t i = 0; i < run.pieces.pieces.size(); ++i) {
         md += "| " + pieces::pieceName(run.pieces, i) + " | " + std::to_string(plate[i]) + " |";

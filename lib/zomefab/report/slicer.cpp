@@ -118,7 +118,11 @@ std::vector<std::string> prusaSlicerArguments(const PrintSettings& s, double bed
                                      "0x0," + bed + "x0," + bed + "x" + bed + ",0x" + bed,
                                      "--max-print-height",
                                      bed};
-    if (s.supports) args.insert(args.end(), {"--support-material", "--support-material-auto"});
+    if (s.supports) {
+        args.insert(args.end(), {"--support-material", "--support-material-auto"});
+        if (std::abs(s.overhangDeg - 45.0) > 1e-9)
+            args.insert(args.end(), {"--support-material-threshold", formatNumber(90.0 - s.overhangDeg, 10)});
+    }
     // PrusaSlicer's automatic width is 1.125 × nozzle; anything else is passed explicitly.
     if (std::abs(s.extrusionWidthMm - 1.125 * s.nozzleMm) > 1e-9) {
         args.push_back("--extrusion-width");

@@ -45,12 +45,13 @@ PieceGrid pieceGrid(const VoxelField& field, const GridCells& cells, const std::
                     const openvdb::math::Transform& transform, const PiecesOptions& options);
 
 /// Checks @p mesh (closed, outward; sealed pockets filled), measures its cut faces, turns it onto
-/// the printer's bed and stores it in @p piece: within the bed less @p bedMarginMm on each side
-/// (pieceBoxMm), centred on the bed of @p printerMm. Returns the orientation's note (empty when a
-/// cut face lies on the bed). @throw Error(ProcessingFailed) naming the piece when its mesh is not
-/// closed; PieceTooLarge when it fits that box in no orientation.
+/// @p fabrication's printer bed and stores it in @p piece: within the bed less its margin on each
+/// side (Fabrication::pieceBoxMm), centred on the bed, with the least support for the printer's
+/// overhang. Returns the orientation's note (empty when a cut face lies on the bed).
+/// @throw Error(ProcessingFailed) naming the piece when its mesh is not closed; PieceTooLarge when
+/// it fits that box in no orientation.
 std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, const CellSet& set,
-                        const Vec3d& printerMm, double bedMarginMm, double voxelMm, double seamGapMm,
+                        const Fabrication& fabrication, double voxelMm, double seamGapMm,
                         const RunContext& context);
 
 }  // namespace zomefab::pieces::detail

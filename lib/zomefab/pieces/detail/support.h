@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <initializer_list>
 #include <vector>
 
@@ -15,12 +16,17 @@ namespace zomefab::pieces::detail {
 
 inline constexpr double kPi = 3.14159265358979323846;
 
-/// The mesh in double precision, with each triangle's vector area (area × unit outward normal).
+/// The mesh in double precision, with each triangle's vector area (area × unit outward normal),
+/// and the printer's steepest overhang without support (Fabrication::overhangDeg) its support is
+/// estimated with.
 struct MeshD {
     std::vector<Vec3d> points;
     std::vector<Triangle> triangles;
     std::vector<Vec3d> vectorArea;
-    explicit MeshD(const TriMesh& m) : triangles(m.triangles) {
+    /// sin(overhang): a facet whose unit normal has more than this along "down" needs support.
+    double overhangSin = std::sin(kOverhangDeg * kPi / 180.0);
+    explicit MeshD(const TriMesh& m, double overhangDeg = kOverhangDeg)
+        : triangles(m.triangles), overhangSin(std::sin(overhangDeg * kPi / 180.0)) {
         points.reserve(m.positions.size());
         for (const Vec3f& p : m.positions) points.push_back(toD(p));
         vectorArea.reserve(triangles.size());
