@@ -119,10 +119,9 @@ CostReport costReport(const TriMesh& objectMm, const std::vector<const TriMesh*>
     const std::pair<const char*, double> cases[] = {{"hollow", options.hollowInfillPercent},
                                                     {"solid", options.solidInfillPercent}};
     for (const auto& [name, infill] : cases) {
-        PrintSettings settings = options.print;
+        PrintSettings settings = report.options.print;  // with the printer's overhang
         settings.infillPercent = infill;
         settings.supports = options.countSupports;
-        settings.overhangDeg = report.options.print.overhangDeg;
         settings.validate();
         CostCase c;
         c.name = name;

@@ -11,6 +11,7 @@
 
 #include "zomefab/core/run_context.h"
 #include "zomefab/core/tri_mesh.h"
+#include "zomefab/pieces/orientation.h"
 
 namespace zomefab::report {
 
@@ -28,13 +29,13 @@ struct PrintSettings {
     double infillPercent = 20.0;  ///< sparse infill density; 100 = solid (paper §7.2 "solid")
     /// Automatic supports under what overhangs (PrusaSlicer's --support-material
     /// --support-material-auto; the estimator: PrintRates::supportShare of the columns under the
-    /// facets steeper than 45°, pieces::estimateSupport).
+    /// facets steeper than overhangDeg, pieces::estimateSupport).
     bool supports = false;
     /// The steepest overhang printed without support, degrees from the vertical: the printer's
     /// (Fabrication::overhangDeg; costReport sets it). The estimator supports what is steeper; at
     /// 45 PrusaSlicer keeps its automatic threshold, otherwise it gets
     /// --support-material-threshold 90 − this (its threshold is measured from the horizontal).
-    double overhangDeg = 45.0;
+    double overhangDeg = pieces::kOverhangDeg;
 
     /// @throw Error(Usage) naming the option for non-positive sizes or infill outside (0, 100].
     void validate() const;

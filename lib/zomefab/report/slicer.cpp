@@ -120,7 +120,7 @@ std::vector<std::string> prusaSlicerArguments(const PrintSettings& s, double bed
                                      bed};
     if (s.supports) {
         args.insert(args.end(), {"--support-material", "--support-material-auto"});
-        if (std::abs(s.overhangDeg - 45.0) > 1e-9)
+        if (std::abs(s.overhangDeg - pieces::kOverhangDeg) > 1e-9)
             args.insert(args.end(), {"--support-material-threshold", formatNumber(90.0 - s.overhangDeg, 10)});
     }
     // PrusaSlicer's automatic width is 1.125 × nozzle; anything else is passed explicitly.
