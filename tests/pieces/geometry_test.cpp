@@ -15,6 +15,7 @@
 #include "zomefab/core/vec.h"
 #include "zomefab/io/threemf.h"
 #include "zomefab/pieces/detail/box_distance.h"
+#include "zomefab/pieces/detail/support.h"
 #include "zomefab/pieces/label.h"
 #include "zomefab/pieces/orientation.h"
 #include "zomefab/pieces/tenons.h"
@@ -607,6 +608,80 @@ TEST_CASE("orientation: support decides: a shelf piece lies on its flat top, not
     TriMesh table = shelf;
     appendMesh(table, zomefab::test::makeBox({10, 0, 0}, {60, 60, 10}));
     CHECK(estimateSupport(table, {0, 0, -1}).volumeMm3 == doctest::Approx(50 * 60 * 40).epsilon(0.05));
+    // The columns standing on the bed: under the shelf, not over the floor (2 mm cells).
+    using pieces::detail::MeshD, pieces::detail::supportColumns;
+    CHECK(supportColumns(MeshD(shelf), {0, 0, -1}).bedMm2 == doctest::Approx(50 * 60).epsilon(0.1));
+    CHECK(supportColumns(MeshD(table), {0, 0, -1}).bedMm2 == 0.0);
+}
+
+/// A spinning top of shell: two cones base to base, @p radiusMm wide at the rim and @p halfMm high
+/// each, the lower tip at the origin, hollow with a wall about @p wallMm thick (the inner top is the
+/// outer scaled about its centre).
+TriMesh hollowTop(double radiusMm, double halfMm, double wallMm) {
+    TriMesh m;
+    const int around = 96;
+    const double pi = std::acos(-1.0);
+    const double inner = 1.0 - wallMm / (radiusMm * halfMm / std::hypot(radiusMm, halfMm));
+    for (int side = 0; side < 2; ++side) {
+        const double s = side == 0 ? 1.0 : inner;
+        const uint32_t base = uint32_t(m.positions.size());
+        m.positions.push_back(Vec3f{0, 0, float(halfMm * (1 - s))});  // lower tip
+        m.positions.push_back(Vec3f{0, 0, float(halfMm * (1 + s))});  // upper tip
+        for (int j = 0; j < around; ++j) {
+            const double a = 2 * pi * j / around;
+            m.positions.push_back(
+                Vec3f{float(s * radiusMm * std::cos(a)), float(s * radiusMm * std::sin(a)), float(halfMm)});
+        }
+        for (uint32_t j = 0; j < uint32_t(around); ++j) {
+            const uint32_t p = base + 2 + j, q = base + 2 + (j + 1) % uint32_t(around);
+            if (side == 0) {
+                m.triangles.push_back({base, q, p});
+                m.triangles.push_back({base + 1, p, q});
+            } else {  // the cavity's wall faces inward
+                m.triangles.push_back({base, p, q});
+                m.triangles.push_back({base + 1, q, p});
+            }
+        }
+    }
+    return m;
+}
+
+TEST_CASE("orientation: a piece that needs least support resting on a point rests on its supports") {
+    // A hollow spinning top 190 mm tall and 120 mm wide, a 2.4 mm wall: on its lower tip no facet
+    // outside or inside is more than 45° from the vertical, but a tip gives no first layer; every
+    // pose with one (on a side) has the cavity's ceiling to support.
+    TriMesh top = hollowTop(60.0, 95.0, 2.4);
+    const double onSide = estimateSupport(top, {std::cos(0.56), 0, -std::sin(0.56)}).volumeMm3;
+    CHECK(onSide > 200e3);
+    // Alone, straight on its tip, nothing overhangs: no support stands on the bed to hold it, so
+    // that pose is not "on its supports" (kMinHoldMm2).
+    const pieces::detail::MeshD alone(top);
+    CHECK(pieces::detail::supportColumns(alone, {0, 0, -1}).bedMm2 == 0.0);
+    CHECK(baseAreaMm2(top, {0, 0, -1}) < 1.0);
+    // With a fin 20 mm above the tip (30 × 30 × 2 mm, as the bunny's head at 400 mm with a 2.4 mm
+    // wall rests on an ear's tip, docs/benchmarks.md), the fin's supports stand on the bed and hold
+    // it: on its tip, with 18 cm³ of columns under the fin against 400 on a side.
+    appendMesh(top, zomefab::test::makeBox({5, -15, 20}, {40, 15, 22}));
+    const PrintOrientation o = orientForPrinter(top, {}, {200, 200, 200});
+    INFO(o.note);
+    CHECK(o.fits);
+    CHECK(std::abs(o.downNormal[2]) > 0.95);  // on a tip
+    CHECK(o.baseAreaMm2 < 25.0);
+    CHECK(o.support.volumeMm3 < 30e3);
+    CHECK(o.note.find("and its supports (print it with supports)") != std::string::npos);
+    if (!report::isSlicerAvailable()) {
+        MESSAGE(
+            "prusa-slicer is not installed (apt-get install --no-install-recommends prusa-slicer): skipped");
+        return;
+    }
+    // PrusaSlicer takes it with its automatic supports (it throws on "no extrusions in the first
+    // layer").
+    TriMesh placed = top;
+    transformInPlace(placed, o.transformMm);
+    report::PrintSettings withSupports;
+    withSupports.supports = true;
+    const report::PrintEstimate e = report::sliceWithPrusaSlicer(placed, withSupports, "top");
+    CHECK(e.filamentMm3 > 0);
 }
 
 TEST_CASE(

@@ -175,7 +175,7 @@ constexpr double kColumnCellMm = 2.0;
 /// mesh is sampled on a kColumnCellMm grid in the bed's plane: each up-facing facet leaves its
 /// height at the cell centres it covers, each overhanging facet adds, per cell centre it covers,
 /// the gap to the highest of those below it.
-double supportColumnsMm3(const MeshD& m, const Vec3d& down) {
+SupportColumns supportColumns(const MeshD& m, const Vec3d& down) {
     const std::array<Vec3d, 3> rows = rotationDown(down);  // rows[2] = up
     std::vector<Vec3d> q(m.points.size());
     double x0 = 1e300, y0 = 1e300, z0 = 1e300;
@@ -206,7 +206,8 @@ double supportColumnsMm3(const MeshD& m, const Vec3d& down) {
         if (dot(m.vectorArea[k], rows[2]) > 0)
             forCells(m.triangles[k], [&](uint64_t cell, double z) { floors.push_back({cell, z}); });
     std::sort(floors.begin(), floors.end());
-    double volume = 0.0;
+    SupportColumns out;
+    std::vector<uint64_t> onBed;  // cells with a column standing on the bed
     for (size_t k = 0; k < m.triangles.size(); ++k) {
         if (!isOverhang(m.vectorArea[k], down, m.overhangSin)) continue;
         forCells(m.triangles[k], [&](uint64_t cell, double z) {
@@ -217,11 +218,18 @@ double supportColumnsMm3(const MeshD& m, const Vec3d& down) {
                 std::lower_bound(floors.begin(), floors.end(), std::make_pair(cell, z - 0.5 * kColumnCellMm));
             double floor = z0;
             if (it != floors.begin() && std::prev(it)->first == cell) floor = std::prev(it)->second;
-            volume += (z - floor) * kColumnCellMm * kColumnCellMm;
+            else
+                onBed.push_back(cell);
+            out.volumeMm3 += (z - floor) * kColumnCellMm * kColumnCellMm;
         });
     }
-    return volume;
+    std::sort(onBed.begin(), onBed.end());
+    out.bedMm2 =
+        double(std::unique(onBed.begin(), onBed.end()) - onBed.begin()) * kColumnCellMm * kColumnCellMm;
+    return out;
 }
+
+double supportColumnsMm3(const MeshD& m, const Vec3d& down) { return supportColumns(m, down).volumeMm3; }
 
 SupportEstimate estimateSupport(const MeshD& m, const Vec3d& down) {
     return {supportOf(m, down).areaMm2, supportColumnsMm3(m, down)};

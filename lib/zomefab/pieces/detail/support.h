@@ -66,7 +66,18 @@ double lowestAlong(const MeshD& m, const Vec3d& up);
 /// estimateSupport's area, and the cheap volume: columns down to the bed (no piece below counted).
 SupportEstimate supportOf(const MeshD& m, const Vec3d& down);
 
-/// estimateSupport's volume: columns down to the first up-facing surface below, or the bed.
+/// supportColumns' answer.
+struct SupportColumns {
+    double volumeMm3 = 0;  ///< estimateSupport's volume
+    /// The footprint of the columns that stand on the bed (not on the piece), mm²: with the
+    /// piece's own first layer, what holds it on the bed.
+    double bedMm2 = 0;
+};
+
+/// Columns under the overhangs down to the first up-facing surface below, or the bed.
+SupportColumns supportColumns(const MeshD& m, const Vec3d& down);
+
+/// estimateSupport's volume: supportColumns(@p m, @p down).volumeMm3.
 double supportColumnsMm3(const MeshD& m, const Vec3d& down);
 
 /// estimateSupport on the double-precision mesh (@p down unit).
