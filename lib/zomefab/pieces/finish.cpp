@@ -91,6 +91,7 @@ std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, cons
     orientation.transformMm.m[7] += bedMarginMm;
     piece.gridToPrintMm = orientation.transformMm;  // flattenBase may lift it a few hundredths
     piece.isCutFaceDown = orientation.isCutFaceDown;
+    piece.isOnSupports = orientation.isOnSupports;
     piece.downNormalGridMm = orientation.downNormal;
     piece.baseAreaMm2 = orientation.baseAreaMm2;
     piece.supportAreaMm2 = orientation.support.areaMm2;

@@ -249,20 +249,20 @@ public:
     }
 
     /// 2b. Resting on its supports (no first layer of kMinBaseMm2, kOnSupportsPenaltyMm3 more):
-    /// the best-scored direction that fits, when it scores better than findResting's choice. (A
-    /// piece no direction gives a first layer rests where it touches the bed most: step 3.)
+    /// the best-scored direction that fits, when it scores better than findResting's choice or
+    /// findResting found none.
     void findOnSupports() {
-        if (!hasRest) return;
         std::sort(onSupports.begin(), onSupports.end());
         for (const auto& [s, i] : onSupports) {
-            if (s >= restScore) break;
+            if (hasRest && s >= restScore) break;
             if (!fits(directions[i])) continue;
-            rest = directions[i], restScore = s, isOnSupports = true;
+            rest = directions[i], restScore = s, hasRest = true, isOnSupports = true;
             break;
         }
     }
 
-    /// 3. No direction has a first layer: the largest contact that fits, if any.
+    /// 3. No direction has a first layer, or supports enough on the bed to hold it: the largest
+    /// contact that fits, if any.
     bool largestContact(Vec3d& down) const {
         std::vector<std::pair<double, size_t>> byContact;  // (−contact, index): largest first
         for (size_t i = 0; i < directions.size(); ++i)
@@ -319,7 +319,7 @@ public:
             note << ", and the best that fits needs " << baseScore / 1000.0 << " cm³ of support against "
                  << out.support.volumeMm3 / 1000.0 << " cm³ this way";
         note << "); it rests on " << out.baseAreaMm2 << " mm²";
-        if (isOnSupports && !out.isCutFaceDown) note << " and its supports (print it with supports)";
+        if (out.isOnSupports) note << " and its supports (print it with supports)";
         return note.str();
     }
 
@@ -409,6 +409,7 @@ PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFa
         out.downNormal = search.base->outwardNormal;
     } else if (search.hasRest) {
         out.downNormal = search.rest;
+        out.isOnSupports = search.isOnSupports;
     } else if (!search.largestContact(out.downNormal)) {
         out.downNormal = search.mostRoom();
     }
@@ -416,7 +417,7 @@ PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFa
     for (const CutFace& f : cutFaces)
         if (!out.isCutFaceDown && dot(f.outwardNormal, out.downNormal) > 1.0 - 1e-12 &&
             search.beyondMm(f) <= flatToleranceMm)
-            out.isCutFaceDown = true;
+            out.isCutFaceDown = true, out.isOnSupports = false;
     out.support = estimateSupport(search.mesh, out.downNormal);
     place(search.mesh, printer, out);
     if (!out.isCutFaceDown) out.note = search.note(out);

@@ -67,6 +67,8 @@ SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down, double
 struct PrintOrientation {
     bool fits = false;           ///< inside the build volume
     bool isCutFaceDown = false;  ///< a cut face lies on the bed
+    /// No first layer of 25 mm²: it stands on its supports, which hold it (print it with them).
+    bool isOnSupports = false;
     Vec3d downNormal{0, 0, -1};  ///< the outward normal (input frame) that points down
     Transform4d transformMm;     ///< input mm → printer mm: on the bed (z = 0), centred in x and y
     Vec3d extentsMm{0, 0, 0};    ///< size along the printer's x, y, z
@@ -86,10 +88,11 @@ struct PrintOrientation {
 /// each is scored by estimateSupport's volume (columns down to the piece below or the bed) plus a
 /// penalty for a first layer under kBrimBelowMm2; the best 8 resting directions are tilted in
 /// small steps towards less support. A cut face wins unless a resting direction scores clearly
-/// better (by 10 % and 2 cm³). When no direction has the first layer, the largest contact that
-/// fits; when nothing fits, the orientation with the most room, fits = false. Support is what
-/// overhangs more than @p overhangDeg from the vertical needs (Fabrication::overhangDeg).
-/// Deterministic.
+/// better (by 10 % and 2 cm³). A direction without the first layer competes too (isOnSupports)
+/// when 400 mm² of its support stands on the bed, at 50 cm³ more. When no direction has the first
+/// layer or that support, the largest contact that fits; when nothing fits, the orientation with the most
+/// room, fits = false. Support is what overhangs more than @p overhangDeg from the vertical needs
+/// (Fabrication::overhangDeg). Deterministic.
 PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFace>& cutFaces,
                                   const Vec3d& printerMm, double flatToleranceMm = kFlatToleranceMm,
                                   double overhangDeg = kOverhangDeg);

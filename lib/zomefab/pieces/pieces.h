@@ -130,6 +130,7 @@ struct Piece {
     TriMesh mesh;
     Transform4d gridToPrintMm;         ///< shell-grid mm → printer mm (a rotation and a translation)
     bool isCutFaceDown = false;        ///< a planar cut face lies on the bed
+    bool isOnSupports = false;         ///< it stands on its supports (PrintOrientation::isOnSupports)
     Vec3d downNormalGridMm{0, 0, -1};  ///< the outward normal (grid mm) that points down when printed
     /// Area of the piece's cross-section kBaseHeightMm (0.2 mm) above the bed: what the first
     /// layer prints. A cut face down gives its area; a piece with none rests on the largest base

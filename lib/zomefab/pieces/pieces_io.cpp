@@ -168,6 +168,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                           {"orientation",
                            {{"transform_mm", toJson(p.gridToPrintMm)},
                             {"cut_face_down", p.isCutFaceDown},
+                            {"on_supports", p.isOnSupports},
                             {"down_normal", toJson(p.downNormalGridMm)},
                             {"base_area_mm2", p.baseAreaMm2},
                             {"support_area_mm2", p.supportAreaMm2},

@@ -107,6 +107,7 @@ void readOrientation(const json& o, Piece& piece, const std::string& what) {
         return transformFromJson(v, what + ".transform_mm");
     });
     piece.isCutFaceDown = o.value("cut_face_down", false);
+    piece.isOnSupports = o.value("on_supports", false);
     piece.downNormalGridMm = optionalField(o, "down_normal", Vec3d{0, 0, -1}, vec("down_normal"));
     auto number = [&](const char* key) {
         return [&, key](const json& v) { return numberFromJson(v, what + "." + key); };

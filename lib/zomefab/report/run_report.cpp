@@ -234,13 +234,15 @@ std::string perPieceMarkdown(const RunRecord& run) {
                   "estimator's, %.0f %% of the solid columns under the overhangs (fitted to PrusaSlicer "
                   "on 19 pieces: +5 %% in all, each within 53 %%, docs/report.md)",
                   100 * run.cost.options.rates.supportShare);
-    std::string md = "\n## Per piece\n\nEach piece's print on its own, " + supportNote +
-                     formatNumbers(
-                         ". Overhang: the area facing down more than %.0f° from the vertical as the "
-                         "piece lies. ",
-                         run.cost.options.print.overhangDeg) +
-                     "Brim: the first layer is under 4 cm².\n\n| piece | plate |" + columns +
-                     " overhang cm² | support g | brim |\n|---|---:|" + rule + "---:|---:|---|\n";
+    std::string md =
+        "\n## Per piece\n\nEach piece's print on its own, " + supportNote +
+        formatNumbers(
+            ". Overhang: the area facing down more than %.0f° from the vertical as the "
+            "piece lies. ",
+            run.cost.options.print.overhangDeg) +
+        "Brim: the first layer is under 4 cm²; \"on supports\": no first layer of its own, it stands on its "
+        "supports (print it with them).\n\n| piece | plate |" +
+        columns + " overhang cm² | support g | brim |\n|---|---:|" + rule + "---:|---:|---|\n";
     double supportG = 0;
     for (size_t i = 0; i < run.pieces.pieces.size(); ++i) {
         md += "| " + pieces::pieceName(run.pieces, i) + " | " + std::to_string(plate[i]) + " |";
@@ -250,7 +252,10 @@ std::string perPieceMarkdown(const RunRecord& run) {
         const double grams = supportGrams(first.pieces[i]);
         supportG += grams;
         md += formatNumbers(" %.0f | %.0f | ", piece.supportAreaMm2 / 100.0, grams) +
-              (piece.isBrimAdvised ? "yes" : "no") + " |\n";
+              (piece.isOnSupports    ? "on supports"
+               : piece.isBrimAdvised ? "yes"
+                                     : "no") +
+              " |\n";
     }
     md += formatNumbers("\nSupport filament in all: %.0f g.\n", supportG);
     md += "\n## Per plate (print job)\n\n" + std::to_string(run.plates.size()) +
