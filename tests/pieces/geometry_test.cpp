@@ -688,28 +688,7 @@ TEST_CASE(
     "orientation: a ball no pose gives a first layer rests on its supports, not on its largest contact") {
     // A solid ball 38 mm across: 0.2 mm above its lowest point its section is 24 mm² in every pose
     // (under kMinBaseMm2), and the columns under its lower half stand on about 570 mm² of the bed.
-    TriMesh ball;
-    const int rings = 48, around = 96;
-    const double r = 19.0, pi = std::acos(-1.0);
-    ball.positions.push_back(Vec3f{0, 0, float(-r)});
-    for (int i = 1; i < rings; ++i)
-        for (int j = 0; j < around; ++j) {
-            const double polar = pi * i / rings, a = 2 * pi * j / around;
-            ball.positions.push_back(Vec3f{float(r * std::sin(polar) * std::cos(a)),
-                                           float(r * std::sin(polar) * std::sin(a)),
-                                           float(-r * std::cos(polar))});
-        }
-    ball.positions.push_back(Vec3f{0, 0, float(r)});
-    const uint32_t last = uint32_t(ball.positions.size() - 1);
-    auto at = [&](int i, int j) { return uint32_t(1 + (i - 1) * around + j % around); };
-    for (int j = 0; j < around; ++j) {
-        ball.triangles.push_back({0, at(1, j + 1), at(1, j)});
-        ball.triangles.push_back({last, at(rings - 1, j), at(rings - 1, j + 1)});
-        for (int i = 1; i + 1 < rings; ++i) {
-            ball.triangles.push_back({at(i, j), at(i, j + 1), at(i + 1, j + 1)});
-            ball.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i + 1, j)});
-        }
-    }
+    const TriMesh ball = zomefab::test::makeSphere({0, 0, 0}, 19.0, 48, 96);
     const PrintOrientation o = orientForPrinter(ball, {}, {200, 200, 200});
     INFO(o.note);
     CHECK(o.fits);

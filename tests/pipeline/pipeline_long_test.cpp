@@ -29,6 +29,7 @@
 #include "zomefab/pipeline/pipeline.h"
 #include "zomefab/report/cost_report.h"
 #include "zomefab/report/run_report.h"
+#include "zomefab/report/slicer.h"
 #include "zomefab/zome/parts.h"
 #include "zomefab/zome/structure_json.h"
 
@@ -345,31 +346,6 @@ TEST_CASE(
         CHECK(placed[pieces::pieceName(d.result.pieces, i)] == 1);
 }
 
-/// The share of a PrusaSlicer G-code's extrusion (relative E, M83) laid down in its
-/// ";TYPE:Support material" and ";TYPE:Support material interface" sections.
-static double supportShare(const std::string& gcode) {
-    std::istringstream lines(gcode);
-    std::string line;
-    bool isSupport = false, isRelative = false;
-    double all = 0, support = 0, lastE = 0;
-    const std::regex extrude(R"(\bE(-?[0-9.]+))");
-    while (std::getline(lines, line)) {
-        if (line.rfind(";TYPE:", 0) == 0) isSupport = line.rfind(";TYPE:Support material", 0) == 0;
-        if (line.rfind("M83", 0) == 0) isRelative = true;
-        if (line.rfind("M82", 0) == 0) isRelative = false;
-        std::smatch m;
-        const std::string code = line.substr(0, line.find(';'));
-        if (line.rfind("G92", 0) == 0 && std::regex_search(code, m, extrude)) lastE = std::stod(m[1]);
-        if (line.rfind("G1 ", 0) != 0 || !std::regex_search(code, m, extrude)) continue;
-        const double e = std::stod(m[1]), de = isRelative ? e : e - lastE;
-        if (!isRelative) lastE = e;
-        if (de <= 0) continue;
-        all += de;
-        if (isSupport) support += de;
-    }
-    return all > 0 ? support / all : 0.0;
-}
-
 TEST_CASE(
     "long: automatic supports on the demo's plates need at most half of what the cut-face orientation did") {
     if (!report::isSlicerAvailable()) {
@@ -388,12 +364,9 @@ TEST_CASE(
     for (const json& plate : d.report["plates"]) {
         const std::string file = d.file(plate["file"].get<std::string>());
         INFO(file);
-        const std::string text = slicePlate(
-            file, bed, "--nozzle-diameter 0.4 --filament-diameter 2.85 --fill-density 20% --perimeters 3");
-        const size_t at = text.find("; filament used [cm3] = ");
-        REQUIRE(at != std::string::npos);
-        const double share = supportShare(text);
-        const double mm3 = share * 1000.0 * std::stod(text.substr(at + 24));
+        std::istringstream gcode(slicePlate(
+            file, bed, "--nozzle-diameter 0.4 --filament-diameter 2.85 --fill-density 20% --perimeters 3"));
+        const double mm3 = report::supportFilamentMm(gcode) * std::acos(-1.0) * 1.425 * 1.425;  // 2.85 mm
         MESSAGE(plate["file"].get<std::string>() << ": support " << mm3 / 1000 << " cm³");
         supportMm3 += mm3;
     }
