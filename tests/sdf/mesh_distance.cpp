@@ -139,7 +139,8 @@ double MeshDistance::distance(const Vec3d& p, Vec3d* closest) const {
     return std::sqrt(best2);
 }
 
-std::vector<Vec3d> sampleSurface(const TriMesh& mesh, size_t count, uint32_t seed) {
+std::vector<Vec3d> sampleSurface(const TriMesh& mesh, size_t count, uint32_t seed,
+                                 std::vector<uint32_t>* facets) {
     std::vector<double> cumulative(mesh.triangles.size());
     double total = 0;
     for (size_t f = 0; f < mesh.triangles.size(); ++f) {
@@ -158,6 +159,7 @@ std::vector<Vec3d> sampleSurface(const TriMesh& mesh, size_t count, uint32_t see
         const size_t f =
             size_t(std::lower_bound(cumulative.begin(), cumulative.end(), x) - cumulative.begin());
         const Triangle& t = mesh.triangles[std::min(f, mesh.triangles.size() - 1)];
+        if (facets != nullptr) facets->push_back(uint32_t(std::min(f, mesh.triangles.size() - 1)));
         double u = uniform(rng), v = uniform(rng);
         if (u + v > 1) {
             u = 1 - u;

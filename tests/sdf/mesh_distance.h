@@ -28,8 +28,10 @@ private:
     std::vector<uint32_t> mItems;  ///< triangle indices
 };
 
-/// @p count points spread over the surface with probability proportional to area (fixed @p seed).
-std::vector<Vec3d> sampleSurface(const TriMesh& mesh, size_t count, uint32_t seed);
+/// @p count points spread over the surface with probability proportional to area (fixed @p seed);
+/// the triangle each lies on appended to @p facets when given.
+std::vector<Vec3d> sampleSurface(const TriMesh& mesh, size_t count, uint32_t seed,
+                                 std::vector<uint32_t>* facets = nullptr);
 
 /// The @p q quantile (0..1) of @p values (copied, partially sorted).
 double quantile(std::vector<double> values, double q);

@@ -29,7 +29,8 @@ std::vector<size_t> stepPegs(const mount::InstallationPlan& plan, const std::vec
 }
 
 std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, size_t before,
-                                           const std::string& what, Change kind) {
+                                           const std::string& what, Change kind,
+                                           const std::function<bool()>& refine) {
     const Stopwatch clock;
     State kept{out.pieces, grouping.cellSets, grouping.faces, field.owner, out.plan, candidates,
                lost,       preGlued,          std::nullopt};
@@ -44,7 +45,13 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
         candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
     out.plan =
         planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context, preGlued);
-    const size_t after = !out.plan.isBuildable() ? SIZE_MAX : steps ? underHeldStepsNow() : underHeldNow();
+    size_t after = !out.plan.isBuildable() ? SIZE_MAX : steps ? underHeldStepsNow() : underHeldNow();
+    if (after == before && refine && refine()) {
+        // As many under-held as before: one change more on top, planned and judged with it.
+        out.plan =
+            planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context, preGlued);
+        after = !out.plan.isBuildable() ? SIZE_MAX : steps ? underHeldStepsNow() : underHeldNow();
+    }
     context.debug("mounting: " + what + ": " + (steps ? "steps" : "pieces") + " under " +
                   std::to_string(opt.tenons.minPerPiece) + " pegs " + std::to_string(before) + " -> " +
                   (after == SIZE_MAX ? std::string("no plan") : std::to_string(after)) + " in " +
@@ -363,17 +370,30 @@ void glueUnderHeld(Replanner& r) {
     // The groups the plan glued where no order existed start glued: the trials plan without
     // gluing more (planOverCandidates), so they must not need those rounds again.
     if (r.preGlued.empty()) r.preGlued = r.out.plan.glued;
+    // A group that holds its step may take a peg from another step (the armadillo at 500 mm: its
+    // leg glued to the hip is held, and the piece next to them loses a peg to the group's path):
+    // that step's own best glue, on top, is tried with it (one plan more).
+    size_t added = 0;
+    auto refine = [&] {
+        const Pairs more = glueUnderHeldOptions(r, stepPegs(r.out.plan, r.pegs()));
+        if (more.empty()) return false;
+        const mount::InstallationPlan& plan = r.out.plan;
+        r.preGlued.push_back({plan.steps[more[0].first].pieces[0], plan.steps[more[0].second].pieces[0]});
+        added = 1;
+        return true;
+    };
     auto attempt = [&](const Pairs& batch, size_t before) {
         const mount::InstallationPlan plan = r.out.plan;
+        added = 0;
         const std::optional<size_t> after = r.tryChange(
             [&] {
                 for (const auto& [step, neighbor] : batch)
                     r.preGlued.push_back({plan.steps[step].pieces[0], plan.steps[neighbor].pieces[0]});
             },
-            before, std::to_string(batch.size()) + " glued group(s)", Replanner::Change::kGroups);
+            before, std::to_string(batch.size()) + " glued group(s)", Replanner::Change::kGroups, refine);
         if (!after) return false;
-        r.out.gluedForPegs += batch.size();
-        r.context.detail(std::to_string(batch.size()) +
+        r.out.gluedForPegs += batch.size() + added;
+        r.context.detail(std::to_string(batch.size() + added) +
                          " step(s) too few pegs would hold glued to a neighbour before mounting (" +
                          std::to_string(before) + " -> " + std::to_string(*after) + " steps under " +
                          std::to_string(minPegs) + " pegs)");

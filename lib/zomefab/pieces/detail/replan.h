@@ -114,8 +114,11 @@ public:
     /// (kGroups: steps) when it is below
     /// @p before with a plan that can be carried out (kMorePieces: not above @p before, with more
     /// pieces held); else undoes everything and returns nothing.
+    /// @p refine (kGroups): when the change leaves as many under-held as before, a further change on
+    /// top (true when it made one), planned and judged together with the first.
     std::optional<size_t> tryChange(const std::function<void()>& change, size_t before,
-                                    const std::string& what, Change kind = Change::kPieces);
+                                    const std::string& what, Change kind = Change::kPieces,
+                                    const std::function<bool()>& refine = {});
 
     Pieces& out;
     VoxelField& field;
