@@ -25,6 +25,7 @@
 #include "zomefab/pieces/detail/merges.h"
 #include "zomefab/pieces/detail/replan.h"
 #include "zomefab/pieces/detail/splits.h"
+#include "zomefab/pieces/detail/stages.h"
 #include "zomefab/pieces/detail/support.h"
 #include "zomefab/pieces/detail/voxels.h"
 #include "zomefab/pieces/orientation.h"
@@ -382,6 +383,33 @@ TEST_CASE("pieces: the voxels' cells, searched among each leaf's candidates, are
     CHECK(mismatches == 0);
     CHECK(used.size() >= 10);
     CHECK(used.count(60) == 0);  // always tied with cell 5, which wins
+}
+
+TEST_CASE("pieces: the band outside the wall is told from the hollow's (the outer surface's mesh)") {
+    // A hollow sphere of radius 100 mm with an 8 mm wall: the band voxels outside the wall beyond
+    // r = 100 are the object's outside, those within r = 92 the hollow, which no 6-connected path
+    // through the band reaches from outside.
+    const VoxelField field = buildField(*sdf::levelSetGrid(shell()));
+    const std::vector<uint8_t> exterior = exteriorBand(field);
+    REQUIRE(exterior.size() == field.phi.size());
+    size_t outside = 0, hollow = 0, wrong = 0;
+    for (size_t s = 0; s < field.phi.size(); ++s) {
+        if (!field.isActive[s] || field.phi[s] < 0) {
+            wrong += exterior[s];  // inside the wall, or not in the field
+            continue;
+        }
+        const double r = norm(field.world(field.coordOf(s)));
+        if (r > kRadius - 0.5 * kShell) {
+            ++outside;
+            wrong += exterior[s] ? 0 : 1;
+        } else {
+            ++hollow;
+            wrong += exterior[s];
+        }
+    }
+    CHECK(outside > 10000);
+    CHECK(hollow > 10000);
+    CHECK(wrong == 0);
 }
 
 TEST_CASE("pieces: bad inputs and options") {

@@ -97,13 +97,14 @@ std::vector<PieceGrid> pieceGrids(const Pieces& out, const VoxelField& field, co
                                   const RunContext& context) {
     const size_t pieceCount = out.pieces.size();
     const std::vector<std::vector<uint32_t>> pieceLeaves = leavesOfPieces(field, pieceCount);
+    const std::vector<uint8_t> exterior = exteriorBand(field);
     std::vector<PieceGrid> grids(pieceCount);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, pieceCount, 1),
                       [&](const tbb::blocked_range<size_t>& range) {
                           for (size_t p = range.begin(); p < range.end(); ++p) {
                               context.throwIfCancelled();
                               grids[p] = pieceGrid(field, cells, cellSets, out.pieces[p], pieceLeaves[p],
-                                                   shell.transform(), out.options);
+                                                   exterior, shell.transform(), out.options);
                           }
                       });
     context.throwIfCancelled();
@@ -130,8 +131,10 @@ void meshPieces(Pieces& out, std::vector<PieceGrid>& grids, const GridCells& cel
             for (size_t p = range.begin(); p < range.end(); ++p) {
                 context.throwIfCancelled();
                 TriMesh mesh;
-                tbb::this_task_arena::isolate(
-                    [&] { mesh = sdf::meshFloatGrid(*grids[p].grid, meshing, grids[p].fullResolution); });
+                tbb::this_task_arena::isolate([&] {
+                    mesh = sdf::meshFloatGrid(*grids[p].grid, meshing, grids[p].fullResolution,
+                                              grids[p].adaptivityWeight);
+                });
                 grids[p] = PieceGrid();
                 // The pegs as exact meshes, overlapping the meshed prisms (tenons.h, pegMesh).
                 for (const Tenon& t : out.pieces[p].tenons) appendMesh(mesh, pegMesh(t, out.options.tenons));

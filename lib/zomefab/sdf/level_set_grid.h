@@ -37,13 +37,15 @@ LevelSet wrapLevelSetGrid(openvdb::FloatGrid::Ptr grid, LevelSetInfo info);
 
 /// The closed, outward triangle mesh of {φ = @p options.isoMm} of @p grid: OpenVDB's VolumeToMesh
 /// (dual contouring) with @p options.adaptivity, full resolution wherever @p fullResolution is
-/// active (may be null), every polygon reversed (OpenVDB winds clockwise seen from outside,
+/// active (may be null), the adaptivity scaled by @p adaptivityWeight's value at each voxel where it
+/// is given (may be null; background 1), every polygon reversed (OpenVDB winds clockwise seen from outside,
 /// zomefab counter-clockwise), quads split along their shorter diagonal, and closed components
 /// under options.minComponentVolumeMm3 dropped (specks where the surface grazes a voxel).
 /// Deterministic: OpenVDB's output order for a given grid, each polygon pool's quads then its
 /// triangles. The one mesher of the library (levelSetToMesh, the pieces stage).
 TriMesh meshFloatGrid(const openvdb::FloatGrid& grid, const LevelSetToMeshOptions& options,
-                      const openvdb::BoolTree::Ptr& fullResolution = nullptr);
+                      const openvdb::BoolTree::Ptr& fullResolution = nullptr,
+                      const openvdb::FloatGrid::ConstPtr& adaptivityWeight = nullptr);
 
 /// Passes OpenVDB's progress to RunContext::progress(stage, percent / 100) and asks it whether to
 /// stop. OpenVDB operations return early (with a partial or empty result) when interrupted, so

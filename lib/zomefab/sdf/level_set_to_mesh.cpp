@@ -11,10 +11,12 @@
 namespace zomefab::sdf {
 
 TriMesh meshFloatGrid(const openvdb::FloatGrid& grid, const LevelSetToMeshOptions& options,
-                      const openvdb::BoolTree::Ptr& fullResolution) {
+                      const openvdb::BoolTree::Ptr& fullResolution,
+                      const openvdb::FloatGrid::ConstPtr& adaptivityWeight) {
     openvdb::tools::VolumeToMesh mesher(options.isoMm, options.adaptivity,
                                         /*relaxDisorientedTriangles=*/true);
     if (fullResolution) mesher.setAdaptivityMask(fullResolution);
+    if (adaptivityWeight) mesher.setSpatialAdaptivity(adaptivityWeight);
     mesher(grid);
     TriMesh mesh;
     const openvdb::tools::PointList& points = mesher.pointList();

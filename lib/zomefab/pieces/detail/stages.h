@@ -34,15 +34,24 @@ void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping
 /// three voxels wide).
 std::vector<std::vector<uint32_t>> leavesOfPieces(const VoxelField& field, size_t pieceCount);
 
-/// One piece's level set ψ_P = max(φ_shell, δ_P) ∪ tenons − number, and where the mesher keeps
-/// full resolution (around tenons and numbers; null when there are none).
+/// Per slot of @p field: 1 for the voxels outside the wall that the outside of the object reaches
+/// (6-connected, from the topmost), 0 for the rest (inside the wall, the hollow, the tunnels' far
+/// band where they are not connected to it in the band).
+std::vector<uint8_t> exteriorBand(const VoxelField& field);
+
+/// One piece's level set ψ_P = max(φ_shell, δ_P) ∪ tenons − number, where the mesher keeps full
+/// resolution (cut faces, around tenons and numbers; null when there are none) and where it merges
+/// little (the outer surface next to @p exterior, exteriorBand; null at adaptivity 0).
 struct PieceGrid {
     FloatGrid::Ptr grid;
     openvdb::BoolTree::Ptr fullResolution;
+    /// The mesher's adaptivity scaled down on the outer surface (kOuterAdaptivityWeight), 1 elsewhere.
+    FloatGrid::Ptr adaptivityWeight;
 };
 PieceGrid pieceGrid(const VoxelField& field, const GridCells& cells, const std::vector<CellSet>& sets,
                     const Piece& piece, const std::vector<uint32_t>& leaves,
-                    const openvdb::math::Transform& transform, const PiecesOptions& options);
+                    const std::vector<uint8_t>& exterior, const openvdb::math::Transform& transform,
+                    const PiecesOptions& options);
 
 /// Checks @p mesh (closed, outward; sealed pockets filled), measures its cut faces, turns it onto
 /// @p fabrication's printer bed and stores it in @p piece: within the bed less its margin on each
