@@ -89,10 +89,7 @@ TriMesh piecesInGridMm(const pieces::Pieces& all) {
     for (const pieces::Piece& p : all.pieces) {
         TriMesh m = p.mesh;
         transformInPlace(m, affineInverse(p.gridToPrintMm));
-        const auto base = uint32_t(out.positions.size());
-        out.positions.insert(out.positions.end(), m.positions.begin(), m.positions.end());
-        for (const Triangle& t : m.triangles)
-            out.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+        appendMesh(out, m);
     }
     return out;
 }
@@ -453,15 +450,19 @@ TEST_CASE(
     // support filament on this demo. (A piece that stands on its supports cannot be sliced without
     // them: "no extrusions in the first layer".)
     constexpr double kBeforeMm3 = 1915e3;
+    constexpr double kFilamentMm = 2.85;
+    const double filamentAreaMm2 = 0.25 * std::acos(-1.0) * kFilamentMm * kFilamentMm;
     const DemoRun& d = demo();
     const Vec3d bed = d.options.fabrication.printerMm;
     double supportMm3 = 0;
     for (const json& plate : d.report["plates"]) {
         const std::string file = d.file(plate["file"].get<std::string>());
         INFO(file);
-        std::istringstream gcode(slicePlate(
-            file, bed, "--nozzle-diameter 0.4 --filament-diameter 2.85 --fill-density 20% --perimeters 3"));
-        const double mm3 = report::supportFilamentMm(gcode) * std::acos(-1.0) * 1.425 * 1.425;  // 2.85 mm
+        std::istringstream gcode(slicePlate(file, bed,
+                                            "--nozzle-diameter 0.4 --filament-diameter " +
+                                                formatNumber(kFilamentMm, 4) +
+                                                " --fill-density 20% --perimeters 3"));
+        const double mm3 = report::supportFilamentMm(gcode) * filamentAreaMm2;
         MESSAGE(plate["file"].get<std::string>() << ": support " << mm3 / 1000 << " cm³");
         supportMm3 += mm3;
     }

@@ -157,9 +157,10 @@ std::vector<Vec3d> sampleSurface(const TriMesh& mesh, size_t count, uint32_t see
     for (size_t s = 0; s < count; ++s) {
         const double x = uniform(rng) * total;
         const size_t f =
-            size_t(std::lower_bound(cumulative.begin(), cumulative.end(), x) - cumulative.begin());
-        const Triangle& t = mesh.triangles[std::min(f, mesh.triangles.size() - 1)];
-        if (facets != nullptr) facets->push_back(uint32_t(std::min(f, mesh.triangles.size() - 1)));
+            std::min(size_t(std::lower_bound(cumulative.begin(), cumulative.end(), x) - cumulative.begin()),
+                     mesh.triangles.size() - 1);
+        const Triangle& t = mesh.triangles[f];
+        if (facets != nullptr) facets->push_back(uint32_t(f));
         double u = uniform(rng), v = uniform(rng);
         if (u + v > 1) {
             u = 1 - u;

@@ -17,14 +17,6 @@ namespace {
 
 constexpr int kFaceOffsets[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 
-/// The active slot of voxel @p ijk, or SIZE_MAX.
-size_t slotOf(const VoxelField& field, const Coord& ijk) {
-    const uint32_t leaf = field.leafAt(ijk & ~7);
-    if (leaf == kNone) return SIZE_MAX;
-    const size_t slot = size_t(leaf) * kLeafSize + FloatLeaf::coordToOffset(ijk);
-    return field.isActive[slot] ? slot : SIZE_MAX;
-}
-
 /// δ of the cells' region of @p set and the half-spaces of its re-cuts (no seam gap).
 double pieceRegionDistance(const GridCells& cells, const CellSet& set, const Vec3d& x, double* scores) {
     double d = regionDistance(cells, set, x, scores);
@@ -177,7 +169,7 @@ void markFaces(openvdb::BoolTree& mask, const VoxelField& field, uint32_t piece,
             const Coord ijk = field.coordOf(s);
             for (const auto& o : kFaceOffsets) {
                 const Coord n = ijk.offsetBy(o[0], o[1], o[2]);
-                const size_t t = slotOf(field, n);
+                const size_t t = field.slotOf(n);
                 if (t == SIZE_MAX || !isMarked(t)) continue;
                 acc.setValueOn(ijk, true);
                 acc.setValueOn(n, true);
@@ -227,11 +219,11 @@ std::vector<uint8_t> exteriorBand(const VoxelField& field) {
     // The topmost voxel outside the wall is outside the object: no cavity reaches above its top.
     size_t start = SIZE_MAX;
     int top = std::numeric_limits<int>::min();
-    for (size_t s = 0; s < field.phi.size(); ++s)
-        if (field.isActive[s] && field.phi[s] >= 0 && field.coordOf(s).z() > top) {
-            top = field.coordOf(s).z();
-            start = s;
-        }
+    for (size_t s = 0; s < field.phi.size(); ++s) {
+        if (!field.isActive[s] || field.phi[s] < 0) continue;
+        const int z = field.coordOf(s).z();
+        if (z > top) top = z, start = s;
+    }
     if (start == SIZE_MAX) return out;
     std::vector<size_t> stack{start};
     out[start] = 1;
@@ -239,7 +231,7 @@ std::vector<uint8_t> exteriorBand(const VoxelField& field) {
         const Coord ijk = field.coordOf(stack.back());
         stack.pop_back();
         for (const auto& o : kFaceOffsets) {
-            const size_t t = slotOf(field, ijk.offsetBy(o[0], o[1], o[2]));
+            const size_t t = field.slotOf(ijk.offsetBy(o[0], o[1], o[2]));
             if (t == SIZE_MAX || out[t] || field.phi[t] < 0) continue;
             out[t] = 1;
             stack.push_back(t);

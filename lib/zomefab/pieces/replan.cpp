@@ -45,12 +45,15 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
         candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
     out.plan =
         planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context, preGlued);
-    size_t after = !out.plan.isBuildable() ? SIZE_MAX : steps ? underHeldStepsNow() : underHeldNow();
+    auto underHeldAfter = [&] {
+        return !out.plan.isBuildable() ? SIZE_MAX : steps ? underHeldStepsNow() : underHeldNow();
+    };
+    size_t after = underHeldAfter();
     if (after == before && refine && refine()) {
         // As many under-held as before: one change more on top, planned and judged with it.
         out.plan =
             planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context, preGlued);
-        after = !out.plan.isBuildable() ? SIZE_MAX : steps ? underHeldStepsNow() : underHeldNow();
+        after = underHeldAfter();
     }
     context.debug("mounting: " + what + ": " + (steps ? "steps" : "pieces") + " under " +
                   std::to_string(opt.tenons.minPerPiece) + " pegs " + std::to_string(before) + " -> " +
@@ -373,18 +376,16 @@ void glueUnderHeld(Replanner& r) {
     // A group that holds its step may take a peg from another step (the armadillo at 500 mm: its
     // leg glued to the hip is held, and the piece next to them loses a peg to the group's path):
     // that step's own best glue, on top, is tried with it (one plan more).
-    size_t added = 0;
     auto refine = [&] {
         const Pairs more = glueUnderHeldOptions(r, stepPegs(r.out.plan, r.pegs()));
         if (more.empty()) return false;
         const mount::InstallationPlan& plan = r.out.plan;
         r.preGlued.push_back({plan.steps[more[0].first].pieces[0], plan.steps[more[0].second].pieces[0]});
-        added = 1;
         return true;
     };
     auto attempt = [&](const Pairs& batch, size_t before) {
         const mount::InstallationPlan plan = r.out.plan;
-        added = 0;
+        const size_t gluedBefore = r.preGlued.size();
         const std::optional<size_t> after = r.tryChange(
             [&] {
                 for (const auto& [step, neighbor] : batch)
@@ -392,8 +393,9 @@ void glueUnderHeld(Replanner& r) {
             },
             before, std::to_string(batch.size()) + " glued group(s)", Replanner::Change::kGroups, refine);
         if (!after) return false;
-        r.out.gluedForPegs += batch.size() + added;
-        r.context.detail(std::to_string(batch.size() + added) +
+        const size_t glued = r.preGlued.size() - gluedBefore;  // the batch, and refine's when it helped
+        r.out.gluedForPegs += glued;
+        r.context.detail(std::to_string(glued) +
                          " step(s) too few pegs would hold glued to a neighbour before mounting (" +
                          std::to_string(before) + " -> " + std::to_string(*after) + " steps under " +
                          std::to_string(minPegs) + " pegs)");

@@ -34,9 +34,9 @@ void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping
 /// three voxels wide).
 std::vector<std::vector<uint32_t>> leavesOfPieces(const VoxelField& field, size_t pieceCount);
 
-/// Per slot of @p field: 1 for the voxels outside the wall that the outside of the object reaches
-/// (6-connected, from the topmost), 0 for the rest (inside the wall, the hollow, the tunnels' far
-/// band where they are not connected to it in the band).
+/// Per slot of @p field: 1 for the band voxels outside the wall 6-connected to the topmost one (the
+/// object's outside), 0 for the rest (inside the wall, the hollow's band, and the band of any other
+/// component of the object, which the outer surface's meshing then treats as inner).
 std::vector<uint8_t> exteriorBand(const VoxelField& field);
 
 /// One piece's level set ψ_P = max(φ_shell, δ_P) ∪ tenons − number, where the mesher keeps full

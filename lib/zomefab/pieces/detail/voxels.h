@@ -107,14 +107,18 @@ struct VoxelField {
         const auto it = leafIndex.find(leafKey(origin));
         return it == leafIndex.end() ? kNone : it->second;
     }
-    /// The slot of the voxel nearest to @p p, or SIZE_MAX outside the field.
-    size_t slotAt(const Vec3d& p) const {
-        Coord ijk;
-        for (int a = 0; a < 3; ++a) ijk[a] = int(std::lround((p[size_t(a)] - originMm[size_t(a)]) / voxelMm));
+    /// The slot of voxel @p ijk, or SIZE_MAX outside the field.
+    size_t slotOf(const Coord& ijk) const {
         const uint32_t leaf = leafAt(ijk & ~7);
         if (leaf == kNone) return SIZE_MAX;
         const size_t slot = size_t(leaf) * kLeafSize + FloatLeaf::coordToOffset(ijk);
         return isActive[slot] ? slot : SIZE_MAX;
+    }
+    /// The slot of the voxel nearest to @p p, or SIZE_MAX outside the field.
+    size_t slotAt(const Vec3d& p) const {
+        Coord ijk;
+        for (int a = 0; a < 3; ++a) ijk[a] = int(std::lround((p[size_t(a)] - originMm[size_t(a)]) / voxelMm));
+        return slotOf(ijk);
     }
 };
 
