@@ -882,17 +882,26 @@ TEST_CASE("pieces: two under-held neighbours are cut anew along a plane that hol
     CHECK(findHoldingSplits(slab, pointers(even), sweeps, search, {50, 50, 50}, 1.0, 2, 3).bothFit.empty());
 }
 
-TEST_CASE("pieces: a closed box of thin wall is cut into two cups that need no support") {
-    // A closed 100 mm cube of 4 mm wall (2 mm cells): however it lies, its ceiling hangs over the
-    // inside, 92 mm of columns under 92 × 92 mm. Cut through the middle, each half is a cup that
-    // lies on its bottom, open side up: next to no support. Candidates two on each side of x = 0.
-    CoarseCells box;
-    box.cellMm = 2.0;
-    for (int i = -25; i <= 25; ++i)
-        for (int j = -25; j <= 25; ++j)
-            for (int k = -25; k <= 25; ++k)
-                if (std::max({std::abs(i), std::abs(j), std::abs(k)}) >= 24)
-                    box.centresMm.push_back({2.0 * i, 2.0 * j, 2.0 * k});
+/// A closed spherical shell, 140 mm across with a 6 mm wall, on 2 mm cells: however it lies, the
+/// top of its inside hangs over the hollow (a closed cube would not do: lying on an edge, its
+/// faces lean at 45°, which prints without support).
+CoarseCells closedSphereCells() {
+    CoarseCells out;
+    out.cellMm = 2.0;
+    for (int i = -35; i <= 35; ++i)
+        for (int j = -35; j <= 35; ++j)
+            for (int k = -35; k <= 35; ++k) {
+                const double r = 2.0 * std::sqrt(double(i * i + j * j + k * k));
+                if (r >= 64.0 && r <= 70.0) out.centresMm.push_back({2.0 * i, 2.0 * j, 2.0 * k});
+            }
+    return out;
+}
+
+TEST_CASE("pieces: a closed shell is cut into two bowls that need little support") {
+    // The closed sphere above. Cut through the middle, each half is a bowl that lies on its
+    // bottom, open side up: support only under the flat of its bottom. Candidates two on each
+    // side of x = 0.
+    const CoarseCells box = closedSphereCells();
     const zome::Structure none;
     const FrameSweeps sweeps(none, Transform4d::identity(), Box3d{}, 1.0, 1.0);
     const std::vector<TenonCandidate> list = candidatesAlongX({-40.0, -30.0, 30.0, 40.0});
@@ -902,18 +911,72 @@ TEST_CASE("pieces: a closed box of thin wall is cut into two cups that need no s
     const Fabrication printer = printerOf({200, 200, 200});
     const std::optional<SupportCut> cut = supportCut(box, candidates, sweeps, search, printer, 2);
     REQUIRE(cut.has_value());
-    CHECK(cut->beforeMm3 > 500e3);                // most of the 92 mm cube's inside
-    CHECK(cut->afterMm3 < 0.1 * cut->beforeMm3);  // the cups: a few cells' worth
-    CHECK(std::abs(cut->plane.normal[0]) > 0.99);
+    CAPTURE(cut->beforeMm3);
+    CAPTURE(cut->afterMm3);
+    CHECK(cut->beforeMm3 > 100e3);                // columns under the top of the inside
+    CHECK(cut->afterMm3 < 0.4 * cut->beforeMm3);  // the bowls: under their bottoms
+    // Through the middle, two candidates on each side.
     CHECK(std::abs(cut->plane.offsetMm) < 12.0);
-    // A cube of the same wall that does not close (its ceiling gone) is a cup already: no cut.
+    auto side = [&](const TenonCandidate& c) {
+        return dot(cut->plane.normal, c.tenon.ballCenterGridMm) > cut->plane.offsetMm;
+    };
+    for (const TenonCandidate& c : list)
+        CHECK(side(c) == (side(list.back()) == (c.tenon.ballCenterGridMm[0] > 0)));
+    // The lower half alone is a bowl already: no cut.
     CoarseCells cup;
     cup.cellMm = 2.0;
     for (const Vec3d& x : box.centresMm)
-        if (x[2] < 42.0) cup.centresMm.push_back(x);
+        if (x[2] < 0.0) cup.centresMm.push_back(x);
     CHECK_FALSE(supportCut(cup, candidates, sweeps, search, printer, 2).has_value());
     // A printer too small for the halves: no cut that fits.
     CHECK_FALSE(supportCut(box, candidates, sweeps, search, printerOf({60, 60, 60}), 2).has_value());
+}
+
+TEST_CASE("pieces: a closed shell no peg holds in halves is printed in two parts glued together") {
+    // The closed sphere of the case above, with no tenon candidates at all: no cut keeps both
+    // halves held (supportCut), but printed in two parts glued before mounting (printSplit) they
+    // need not be: the same two bowls.
+    const CoarseCells box = closedSphereCells();
+    const zome::Structure none;
+    const FrameSweeps sweeps(none, Transform4d::identity(), Box3d{}, 1.0, 1.0);
+    SplitSearch search;
+    search.minVolumeMm3 = 1000.0;
+    const Fabrication printer = printerOf({200, 200, 200});
+    CHECK_FALSE(supportCut(box, {}, sweeps, search, printer, 2).has_value());
+    const std::optional<SupportCut> parts = printSplit(box, search, printer);
+    REQUIRE(parts.has_value());
+    CAPTURE(parts->beforeMm3);
+    CAPTURE(parts->afterMm3);
+    CHECK(parts->beforeMm3 > 100e3);
+    CHECK(parts->afterMm3 < 0.2 * parts->beforeMm3);
+    CHECK(std::abs(parts->plane.offsetMm) < 30.0);  // through the middle or a third: two bowls
+    // A bowl already: nothing to gain.
+    CoarseCells cup;
+    cup.cellMm = 2.0;
+    for (const Vec3d& x : box.centresMm)
+        if (x[2] < 0.0) cup.centresMm.push_back(x);
+    CHECK_FALSE(printSplit(cup, search, printer).has_value());
+}
+
+TEST_CASE("pieces: a thin wall leaning up to 45° needs no support on cells, one leaning further does") {
+    // A wall one 2 mm cell thick and 40 mm wide, 40 layers high, each layer stepped sideways by
+    // @p step cells: 0 stands upright, 1 leans at 45° (what a printer bridges), 2 at 63°, whose
+    // every cell but the first layer's hangs over empty space down to the bed.
+    const double cell = 2.0;
+    auto wall = [&](int step) {
+        std::vector<Vec3d> out;
+        for (int k = 0; k < 40; ++k)
+            for (int j = 0; j < 20; ++j) out.push_back({cell * k * step, cell * j, cell * (k + 0.5)});
+        return out;
+    };
+    const Vec3d up{0, 0, 1};
+    CHECK(restingSupportMm3(wall(0), up, 0.0, cell) == doctest::Approx(0.0));
+    CHECK(restingSupportMm3(wall(1), up, 0.0, cell) == doctest::Approx(0.0));
+    // Layer k (2..39; the first above the bed leans on it) hangs 2k mm over the bed, 20 cells of
+    // 4 mm² each.
+    double columns = 0.0;
+    for (int k = 2; k < 40; ++k) columns += cell * k * 20 * cell * cell;
+    CHECK(restingSupportMm3(wall(2), up, 0.0, cell) == doctest::Approx(columns));
 }
 
 TEST_CASE("pieces: a union no plane cuts into two held pieces that fit is cut into three") {

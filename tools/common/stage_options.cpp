@@ -266,7 +266,7 @@ void PiecesCli::addTo(CLI::App& app) {
     app.add_flag(
         "--cut-for-support", o.isCuttingForSupport,
         "Cut a held piece that needs much support however it lies in two, where both halves stay held "
-        "and need much less support");
+        "and need much less support; else print it in two parts glued together before mounting");
     app.add_flag("--no-glue-groups", isNotGluing,
                  "Do not glue a piece fewer than --min-tenons pegs hold to a neighbour before mounting, nor print "
                  "pieces glued together as one");

@@ -81,7 +81,8 @@ struct PiecesOptions {
     bool isRecuttingPairs = false;
     /// Cut a held piece that needs much support however it lies (a cup of thin wall, a head with
     /// its ears) in two along a plane that holds both halves, where they need much less support
-    /// (docs/pieces.md, "Cut for less support").
+    /// (docs/pieces.md, "Cut for less support"); then, with glued groups, print a piece no such
+    /// cut helps in two parts glued together before mounting ("Printed in parts").
     bool isCuttingForSupport = false;
     /// Glue a piece (or glued group) too few pegs hold to a neighbour before mounting, where the two
     /// go on as one body along a direction whose tenons hold both (docs/mounting.md, "Glued
@@ -165,6 +166,8 @@ struct Pieces {
     size_t recutPairs = 0;
     /// Held pieces cut in two for less support (PiecesOptions::isCuttingForSupport).
     size_t supportCuts = 0;
+    /// Pieces printed in two parts glued together before mounting, for less support (splitForPrint).
+    size_t printSplits = 0;
     /// Pairs glued before mounting because one of them was held by too few pegs (docs/mounting.md).
     size_t gluedForPegs = 0;
     /// The frame with the struts grown toward pieces too few pegs hold (PiecesOptions::

@@ -199,6 +199,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                     {"merged_pieces", all.mergedPieces},
                     {"recut_pairs", all.recutPairs},
                     {"support_cuts", all.supportCuts},
+                    {"print_splits", all.printSplits},
                     {"glued_for_pegs", all.gluedForPegs},
                     {"frame_struts_grown", all.frameStrutsGrown},
                     {"tenons", tenonCount},

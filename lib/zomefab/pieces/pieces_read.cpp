@@ -281,6 +281,7 @@ Pieces piecesFromJson(const json& j, const std::string& directory) {
     out.mergedPieces = countFromJson(summary, "merged_pieces", 0);
     out.recutPairs = countFromJson(summary, "recut_pairs", 0);
     out.supportCuts = countFromJson(summary, "support_cuts", 0);
+    out.printSplits = countFromJson(summary, "print_splits", 0);
     out.gluedForPegs = countFromJson(summary, "glued_for_pegs", 0);
     out.frameStrutsGrown = countFromJson(summary, "frame_struts_grown", 0);
     return out;

@@ -495,6 +495,7 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         glueUnderHeld(replanner);
         mergeGluedPairs(replanner, fabrication);
     }
+    if (opt.isCuttingForSupport && opt.isGluingUnderHeld) splitForPrint(replanner, fabrication);
     const size_t unpinned = placePins(out, field, cells, grouping.cellSets, opt, GlueOnRule{}.minCosine);
     if (unpinned > 0)
         context.warn(std::to_string(unpinned) + " of " +

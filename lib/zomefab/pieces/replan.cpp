@@ -36,12 +36,13 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
                lost,       preGlued,          std::nullopt};
     if (kind == Change::kFrame) kept.frame = frame;
     change();
-    const bool steps = kind == Change::kGroups;
-    if (kind == Change::kPieces || kind == Change::kMorePieces)
+    const bool steps = kind == Change::kGroups || kind == Change::kParts;
+    if (kind == Change::kPieces || kind == Change::kMorePieces || kind == Change::kParts)
         grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
     else if (kind == Change::kFrame)
         remakeSweeps();
-    if (!steps)  // glued groups leave the pieces and the frame, so the candidates, as they are
+    if (kind !=
+        Change::kGroups)  // glued groups leave the pieces and the frame, so the candidates, as they are
         candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
     out.plan =
         planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context, preGlued);
@@ -59,10 +60,12 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
                   std::to_string(opt.tenons.minPerPiece) + " pegs " + std::to_string(before) + " -> " +
                   (after == SIZE_MAX ? std::string("no plan") : std::to_string(after)) + " in " +
                   formatNumber(clock.seconds(), 3) + " s");
-    // kMorePieces: more pieces held (pieces less under-held ones), and no more under-held.
+    // kMorePieces: more pieces held (pieces less under-held ones), and no more under-held;
+    // kParts: no more steps under-held.
     const bool isBetter = kind == Change::kMorePieces
                               ? after <= before && out.pieces.size() - after > kept.pieces.size() - before
-                              : after < before;
+                          : kind == Change::kParts ? after <= before
+                                                   : after < before;
     if (isBetter) return after;
     out.pieces = std::move(kept.pieces);
     grouping.cellSets = std::move(kept.cellSets);

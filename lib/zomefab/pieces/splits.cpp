@@ -206,24 +206,22 @@ std::optional<SplitPlane> coarseFitSplit(const VoxelField& field, const CoarseCe
 
 }  // namespace
 
-double restingSupportMm3(const std::vector<Vec3d>& cells, const Vec3d& up, double offsetMm, double cellMm) {
-    const std::array<Vec3d, 3> rows = rotationDown(scale(up, -1.0));  // rows[2] = up
-    std::unordered_map<int64_t, std::vector<double>> columns;
-    for (const Vec3d& x : cells) {
-        const int64_t i = std::llround(dot(rows[0], x) / cellMm), j = std::llround(dot(rows[1], x) / cellMm);
-        columns[packCell(i, j, 0)].push_back(dot(up, x) - offsetMm);
-    }
-    double gaps = 0.0;
-    for (auto& [key, heights] : columns) {
-        std::sort(heights.begin(), heights.end());
-        double below = 0.0;  // the top of the solid below: the bed first
-        for (const double h : heights) {
-            const double bottom = h - 0.5 * cellMm;
-            if (bottom > below + 0.5 * cellMm) gaps += bottom - below;
-            below = std::max(below, h + 0.5 * cellMm);
+std::vector<SplitPlane> connectedSplitPlanes(const std::vector<Vec3d>& cells, const SplitSearch& search,
+                                             const std::vector<double>& quantiles) {
+    std::vector<SplitPlane> out;
+    if (cells.size() < 2) return out;
+    const VoxelGraph graph = voxelGraph(cells, search);
+    const double cellVolume = search.voxelMm * search.voxelMm * search.voxelMm;
+    for (const double quantile : quantiles)
+        for (const Vec3d& n : splitDirections()) {
+            const SplitPlane plane = planeAt(cells, n, quantile, search.voxelMm);
+            std::vector<uint8_t> side(cells.size());
+            size_t above = 0;
+            for (size_t v = 0; v < cells.size(); ++v) above += side[v] = dot(n, cells[v]) > plane.offsetMm;
+            if (double(std::min(above, cells.size() - above)) * cellVolume < search.minVolumeMm3) continue;
+            if (isConnected(graph, side, 0) && isConnected(graph, side, 1)) out.push_back(plane);
         }
-    }
-    return gaps * cellMm * cellMm;
+    return out;
 }
 
 std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,

@@ -108,6 +108,9 @@ public:
         /// as kPieces, for a change that adds pieces: judged by the pieces held (minPerPiece pegs
         /// or more), which must grow, and the under-held ones, which must not
         kMorePieces,
+        /// as kPieces, for a piece cut into parts glued before mounting (splitForPrint): judged by
+        /// the steps under-held (kGroups), which must not grow
+        kParts,
     };
     /// Makes @p change, recomputes what it touched (for kPieces the faces and the tenon candidates,
     /// for kFrame the sweeps and the candidates) and plans again. Returns the new count of under-held pieces
@@ -193,11 +196,11 @@ std::vector<PairCut> pairCuts(const CoarseCells& cells, const std::vector<const 
 void recutUnderHeldPairs(Replanner& r, const Fabrication& fabrication);
 
 /// The least support a solid of @p cells (cubes of side @p cellMm) needs, resting at its lowest
-/// cell, over 256 directions spread over the sphere and @p ups along which it fits @p boxMm
+/// cell, over @p sphereDirections directions spread over the sphere and @p ups along which it fits @p boxMm
 /// (placeOnBed): restingSupportMm3, mm³ of solid columns; infinite when it fits none
 /// (support_cuts.cpp).
 double leastSupportMm3(const std::vector<Vec3d>& cells, double cellMm, const std::vector<Vec3d>& ups,
-                       const Vec3d& boxMm);
+                       const Vec3d& boxMm, int sphereDirections = 256);
 
 /// A plane that cuts a piece into two halves that need much less support than the piece.
 struct SupportCut {
@@ -206,7 +209,7 @@ struct SupportCut {
     double afterMm3 = 0.0;   ///< its halves', each also lying on the new cut face or with it up
 };
 /// For a piece (@p cells: its coarse cells; @p candidates: its usable tenon candidates) whose least
-/// support is at least half its volume and 30 cm³: of findHoldingSplits's planes that hold both
+/// support is at least a quarter of its volume and 30 cm³: of findHoldingSplits's planes that hold both
 /// halves with @p minPegs and fit the printer, the one whose halves need the least support, when
 /// they need at most 60 % of the piece's and 30 cm³ less. Empty otherwise.
 std::optional<SupportCut> supportCut(const CoarseCells& cells,
@@ -219,6 +222,22 @@ std::optional<SupportCut> supportCut(const CoarseCells& cells,
 /// none more under-held (Change::kMorePieces). At most 6 plans. docs/pieces.md, "Cut for less
 /// support". PiecesOptions::isCuttingForSupport.
 void cutForSupport(Replanner& r, const Fabrication& fabrication);
+
+/// A piece (@p cells: its coarse cells) whose least support (leastSupportMm3 on 4 mm cells) is at
+/// least 30 cm³: of connectedSplitPlanes's planes (median and thirds), the one whose halves need the
+/// least support, each lying any way that fits or on the new cut face or with it up, when they
+/// need at most 60 % of the piece's and 30 cm³ less. Unlike supportCut the halves need not be held
+/// on their own: they are glued into one body before mounting. Empty otherwise.
+std::optional<SupportCut> printSplit(const CoarseCells& cells, SplitSearch search,
+                                     const Fabrication& fabrication);
+
+/// Pieces that need much support however they lie, held or not, are printed in two parts glued
+/// together before mounting (a glued group, Replanner::preGlued, mounted as the piece was): cut
+/// along printSplit's plane, the one that saves the most first, and the plan made again; kept when
+/// no more steps are under-held with a plan that can be carried out (Change::kParts). At most 10
+/// plans. Run after glueUnderHeld and mergeGluedPairs (which would print the parts as one again).
+/// docs/pieces.md, "Printed in parts". PiecesOptions::isCuttingForSupport.
+void splitForPrint(Replanner& r, const Fabrication& fabrication);
 
 /// Steps (pieces or glued groups) fewer than minPerPiece pegs hold, a piece glued on as it goes on
 /// among them, are glued to a neighbouring step before mounting, so the two go on as one body

@@ -145,8 +145,16 @@ HoldingSplits findHoldingSplits(const CoarseCells& cells,
 /// The support a half needs printed lying on its cut face, estimated on its cells (of side
 /// @p cellMm): the plane {x : up·x = @p offsetMm} is the bed and @p up (unit) points into the half;
 /// in each column of cells along @p up, the empty space under every solid run down to the solid
-/// below or the bed (the orientation's support columns, on cells), mm³.
+/// below or the bed (the orientation's support columns, on cells), where no cell two layers lower
+/// within two columns holds the run's lowest cell (a slope of up to 45°, which prints without
+/// support) and it is more than a layer above the bed, mm³ (support_cuts.cpp).
 double restingSupportMm3(const std::vector<Vec3d>& cells, const Vec3d& up, double offsetMm, double cellMm);
+
+/// The planes of findSplit's 13 directions through the @p quantiles of @p cells (coarse cells of
+/// side @p search.voxelMm) along each that leave two 6-connected halves of at least
+/// search.minVolumeMm3, in that order (quantiles first).
+std::vector<SplitPlane> connectedSplitPlanes(const std::vector<Vec3d>& cells, const SplitSearch& search,
+                                             const std::vector<double>& quantiles);
 
 /// Cuts piece @p p along @p plane: its voxels beyond the plane (inside and band) go to a new piece
 /// with the next id, its cell set with the other half-space; shell volumes recounted. Returns the
