@@ -30,6 +30,9 @@ constexpr size_t kFittingPlanes = 8;
 /// across their plane is chosen among them.
 constexpr size_t kFreeOptionsPerHalf = 4;
 
+/// Where split planes cut a piece along each direction: the median first, then the thirds.
+constexpr double kSplitQuantiles[] = {0.5, 1.0 / 3.0, 2.0 / 3.0};
+
 /// The 13 directions of the split planes: axes, face diagonals, body diagonals (unit).
 std::vector<Vec3d> splitDirections() {
     std::vector<Vec3d> out;
@@ -157,18 +160,28 @@ std::pair<size_t, size_t> bestOrderedPair(const MountBody& a, const MountBody& b
 /// weaker held half and of both.
 using SplitValue = std::tuple<size_t, size_t, size_t>;
 
-/// The value of cutting along @p plane: (0, 0, 0) unless both halves are connected and large
-/// enough and one at least can be held.
-SplitValue splitValue(const VoxelGraph& g, const std::vector<const TenonCandidate*>& candidates,
-                      const SplitPlane& plane, const FrameSweeps& sweeps, const SplitSearch& s) {
+/// The side of @p plane each voxel of @p g lies on (1: beyond it), when both halves are connected
+/// and hold at least s.minVolumeMm3; empty otherwise.
+std::optional<std::vector<uint8_t>> connectedSides(const VoxelGraph& g, const SplitPlane& plane,
+                                                   const SplitSearch& s) {
     const std::vector<Vec3d>& voxels = *g.voxels;
     std::vector<uint8_t> side(voxels.size());
     size_t above = 0;
     for (size_t v = 0; v < voxels.size(); ++v)
         above += side[v] = dot(plane.normal, voxels[v]) > plane.offsetMm;
     const double voxelVolume = s.voxelMm * s.voxelMm * s.voxelMm;
-    if (double(std::min(above, voxels.size() - above)) * voxelVolume < s.minVolumeMm3) return {0, 0, 0};
-    if (!isConnected(g, side, 0) || !isConnected(g, side, 1)) return {0, 0, 0};
+    if (double(std::min(above, voxels.size() - above)) * voxelVolume < s.minVolumeMm3) return std::nullopt;
+    if (!isConnected(g, side, 0) || !isConnected(g, side, 1)) return std::nullopt;
+    return side;
+}
+
+/// The value of cutting along @p plane: (0, 0, 0) unless both halves are connected and large
+/// enough and one at least can be held.
+SplitValue splitValue(const VoxelGraph& g, const std::vector<const TenonCandidate*>& candidates,
+                      const SplitPlane& plane, const FrameSweeps& sweeps, const SplitSearch& s) {
+    const std::optional<std::vector<uint8_t>> sides = connectedSides(g, plane, s);
+    if (!sides) return {0, 0, 0};
+    const std::vector<uint8_t>& side = *sides;
     const MountBody a = halfBody(g, side, 0, candidates, plane, sweeps, s);
     const MountBody b = halfBody(g, side, 1, candidates, plane, sweeps, s);
     const DirectionOption *oa = a.bestFree(), *ob = b.bestFree();
@@ -206,20 +219,14 @@ std::optional<SplitPlane> coarseFitSplit(const VoxelField& field, const CoarseCe
 
 }  // namespace
 
-std::vector<SplitPlane> connectedSplitPlanes(const std::vector<Vec3d>& cells, const SplitSearch& search,
-                                             const std::vector<double>& quantiles) {
+std::vector<SplitPlane> connectedSplitPlanes(const std::vector<Vec3d>& cells, const SplitSearch& search) {
     std::vector<SplitPlane> out;
     if (cells.size() < 2) return out;
     const VoxelGraph graph = voxelGraph(cells, search);
-    const double cellVolume = search.voxelMm * search.voxelMm * search.voxelMm;
-    for (const double quantile : quantiles)
+    for (const double quantile : kSplitQuantiles)
         for (const Vec3d& n : splitDirections()) {
             const SplitPlane plane = planeAt(cells, n, quantile, search.voxelMm);
-            std::vector<uint8_t> side(cells.size());
-            size_t above = 0;
-            for (size_t v = 0; v < cells.size(); ++v) above += side[v] = dot(n, cells[v]) > plane.offsetMm;
-            if (double(std::min(above, cells.size() - above)) * cellVolume < search.minVolumeMm3) continue;
-            if (isConnected(graph, side, 0) && isConnected(graph, side, 1)) out.push_back(plane);
+            if (connectedSides(graph, plane, search)) out.push_back(plane);
         }
     return out;
 }
@@ -231,7 +238,7 @@ std::optional<SplitPlane> findSplit(const std::vector<Vec3d>& voxels,
     const VoxelGraph graph = voxelGraph(voxels, search);
     std::optional<SplitPlane> best;
     SplitValue bestValue{0, 0, 0};
-    for (const double quantile : {0.5, 1.0 / 3.0, 2.0 / 3.0}) {
+    for (const double quantile : kSplitQuantiles) {
         for (const Vec3d& n : splitDirections()) {
             const SplitPlane plane = planeAt(voxels, n, quantile, search.voxelMm);
             const SplitValue value = splitValue(graph, candidates, plane, sweeps, search);

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <set>
 #include <unordered_set>
 
@@ -44,8 +45,6 @@ constexpr size_t kPlanesPerPiece = 8;
 constexpr size_t kPrintSplitTrials = 10;
 constexpr double kMaxPartsShare = 0.6;
 constexpr int kPartDirections = 96;
-/// Where the planes cut: the median, then the thirds (findSplit's quantiles).
-const std::vector<double> kPartQuantiles{0.5, 1.0 / 3.0, 2.0 / 3.0};
 
 /// @p cells binned to cubes of @p binMm (their centres, each once).
 std::vector<Vec3d> binned(const std::vector<Vec3d>& cells, double binMm) {
@@ -240,7 +239,7 @@ std::optional<SupportCut> printSplit(const CoarseCells& cells, SplitSearch searc
     // binned() puts the cells' centres at odd multiples of half a bin.
     search.voxelMm = binMm;
     search.originMm = {0.5 * binMm, 0.5 * binMm, 0.5 * binMm};
-    const std::vector<SplitPlane> planes = connectedSplitPlanes(coarse, search, kPartQuantiles);
+    const std::vector<SplitPlane> planes = connectedSplitPlanes(coarse, search);
     std::vector<double> after(planes.size());
     tbb::parallel_for(size_t(0), planes.size(), [&](size_t i) {
         after[i] = halvesSupportMm3(coarse, planes[i], binMm, box, kPartDirections);
@@ -255,12 +254,18 @@ std::optional<SupportCut> printSplit(const CoarseCells& cells, SplitSearch searc
 
 void splitForPrint(Replanner& r, const Fabrication& fabrication) {
     const SplitSearch search = splitSearchFor(r.field, r.opt);
-    auto cutOf = [&](uint32_t, const std::vector<size_t>& slots) {
-        return printSplit(coarseInside(r.field, slots), search, fabrication);
+    // A piece's cut depends on its voxels alone, which only its own cut changes (and the plan made
+    // again leaves alone): each is searched once, again only after its piece was cut.
+    std::map<uint32_t, std::optional<SupportCut>> known;
+    auto cutOf = [&](uint32_t p, const std::vector<size_t>& slots) {
+        const auto it = known.find(p);
+        if (it != known.end()) return it->second;
+        return known[p] = printSplit(coarseInside(r.field, slots), search, fabrication);
     };
     cutInRounds(
         r, kPrintSplitTrials, cutOf, [](uint32_t, const std::vector<size_t>&) { return false; },
         [&](uint32_t p, const SplitPlane& plane) {
+            known.erase(p);
             r.preGlued.push_back({p, splitPiece(r.out.pieces, r.grouping.cellSets, r.field, p, plane)});
         },
         Replanner::Change::kParts, [&] { return r.underHeldStepsNow(); },

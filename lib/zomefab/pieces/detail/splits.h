@@ -150,11 +150,10 @@ HoldingSplits findHoldingSplits(const CoarseCells& cells,
 /// support) and it is more than a layer above the bed, mm³ (support_cuts.cpp).
 double restingSupportMm3(const std::vector<Vec3d>& cells, const Vec3d& up, double offsetMm, double cellMm);
 
-/// The planes of findSplit's 13 directions through the @p quantiles of @p cells (coarse cells of
-/// side @p search.voxelMm) along each that leave two 6-connected halves of at least
-/// search.minVolumeMm3, in that order (quantiles first).
-std::vector<SplitPlane> connectedSplitPlanes(const std::vector<Vec3d>& cells, const SplitSearch& search,
-                                             const std::vector<double>& quantiles);
+/// The planes of findSplit (its 13 directions through the median of @p cells along each, then
+/// through the thirds; coarse cells of side @p search.voxelMm) that leave two 6-connected halves
+/// of at least search.minVolumeMm3, in that order.
+std::vector<SplitPlane> connectedSplitPlanes(const std::vector<Vec3d>& cells, const SplitSearch& search);
 
 /// Cuts piece @p p along @p plane: its voxels beyond the plane (inside and band) go to a new piece
 /// with the next id, its cell set with the other half-space; shell volumes recounted. Returns the
