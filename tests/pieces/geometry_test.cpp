@@ -46,6 +46,21 @@ ShellProbe sphereProbe(double inner, double outer, double cutZ = 1e9) {
     return p;
 }
 
+/// The largest @p past(q) over the points q of tenon @p t's solid on a 0.5 mm grid within 14 mm of
+/// its end: how far the stem reaches past a surface (@p past: signed distance past it, mm).
+template <class Past>
+double farthestSolid(const Tenon& t, const TenonOptions& o, Past&& past) {
+    const Vec3d e = t.pointAt(t.endMm);
+    double worst = -1e9;
+    for (double dx = -14; dx <= 14; dx += 0.5)
+        for (double dy = -14; dy <= 14; dy += 0.5)
+            for (double dz = -14; dz <= 14; dz += 0.5) {
+                const Vec3d q = add(e, Vec3d{dx, dy, dz});
+                if (tenonSignedDistanceMm(t, o, q) < 0) worst = std::max(worst, past(q));
+            }
+    return worst;
+}
+
 zome::Structure oneBall() {
     zome::Structure s;
     s.addBall(zome::GoldenVector3());
@@ -328,7 +343,7 @@ TEST_CASE("tenons: used holes, obstacles, oblique walls and cut edges are reject
         if (c.tenon.hole == 0) CHECK(c.rejection == "crosses another piece");
 }
 
-TEST_CASE("tenons: a thin wall met obliquely holds a stem cut parallel to its outer surface") {
+TEST_CASE("tenons: a thin wall met obliquely holds a stem cut a skin inside its outer surface") {
     // A ball 76.5 mm off the centre of a 4 mm spherical wall (radii 96 and 100): its +y ray meets
     // the wall at 53°, where a square end cannot be buried in 4 mm. The stem runs through the wall
     // and is cut by a plane a skin inside the outer surface: it bonds across the whole wall and
@@ -353,26 +368,17 @@ TEST_CASE("tenons: a thin wall met obliquely holds a stem cut parallel to its ou
             if (t.isClipped()) {
                 ++cut;
                 CHECK(t.tiltDeg > 30.0);
-                // The axis meets the plane inside the wall, past the inner surface.
-                const double axisAtPlane = (t.clipOffsetMm - dot(t.clipNormalGrid, t.ballCenterGridMm)) /
-                                           dot(t.clipNormalGrid, t.axisGrid);
-                CHECK(axisAtPlane > t.baseMm + 0.5);
-                CHECK(norm(t.pointAt(axisAtPlane)) < outer - 0.5);
-                // The hull's wall-end corners lie on the plane.
+                // The axis meets the cut inside the wall, past the inner surface.
+                const double axisAtCut = t.clipAlongAxisMm();
+                CHECK(axisAtCut > t.baseMm + 0.5);
+                CHECK(norm(t.pointAt(axisAtCut)) < outer - 0.5);
+                // The hull's wall-end corners lie on the cut.
                 const std::vector<Vec3d> hull = tenonHullMm(t, o);
-                for (size_t k = 4; k < 8; ++k) CHECK(std::abs(t.beyondClipMm(hull[k])) < 1e-6);
+                for (size_t k = 4; k < 8; ++k) CHECK(std::abs(beyondCutMm(t, o, hull[k])) < 1e-6);
             }
             // Nothing of the solid outside the outer surface less 0.25 mm: sampled on a 0.5 mm
             // grid around its end; and it is solid at the axis halfway through the wall.
-            const Vec3d e = t.pointAt(t.endMm);
-            double worst = -1e9;
-            for (double dx = -14; dx <= 14; dx += 0.5)
-                for (double dy = -14; dy <= 14; dy += 0.5)
-                    for (double dz = -14; dz <= 14; dz += 0.5) {
-                        const Vec3d q = add(e, Vec3d{dx, dy, dz});
-                        if (tenonSignedDistanceMm(t, o, q) < 0) worst = std::max(worst, norm(q) - outer);
-                    }
-            CHECK(worst < -0.25);
+            CHECK(farthestSolid(t, o, [&](const Vec3d& q) { return norm(q) - outer; }) < -0.25);
             CHECK(tenonSignedDistanceMm(t, o, t.pointAt(t.baseMm + 1.0)) < 0);
         }
         if (outer > 50) CHECK(cut >= 1);
@@ -382,6 +388,75 @@ TEST_CASE("tenons: a thin wall met obliquely holds a stem cut parallel to its ou
     ShellProbe thick = sphereProbe(84.0, 100.0);
     for (const TenonCandidate& c : findTenonCandidates(off, Transform4d::identity(), thick, o))
         CHECK_FALSE(c.tenon.isClipped());
+}
+
+TEST_CASE("tenons: a 2.4 mm wall curved either way holds stems cut along its outer surface") {
+    // Two walls 2.4 mm thick, each probed from a ball at the origin: a limb (a cylindrical wall of
+    // outer radius 28 mm along z, its axis `offset` mm off in −x; the ±x and ±y rays meet it 16–24 mm
+    // out, up to 25° off its normal), and a knob seen from outside (a spherical wall of radii 12
+    // and 14.4 whose centre is 30 mm off in −x: the −x ray meets its outside and leaves through its
+    // inside, which curves back towards the ball, so a plane a skin inside that surface leaves the
+    // stem's corners in the air). The cut follows the surface: the stem bonds across the wall
+    // and nothing shows past the surface it leaves by.
+    struct Wall {
+        Vec3d centre;
+        bool isCylinder;
+        double lo, hi;  ///< the material's radii
+        int rays;       ///< the lattice rays that meet it
+    };
+    TenonOptions o;
+    o.holes = TenonHoles::Lattice;
+    for (const Wall& w : {Wall{{0, 0, 0}, true, 25.6, 28, 4}, Wall{{6, 0, 0}, true, 25.6, 28, 4},
+                          Wall{{10, 0, 0}, true, 25.6, 28, 4}, Wall{{30, 0, 0}, false, 12, 14.4, 1}}) {
+        CAPTURE(w.centre[0]);
+        CAPTURE(w.isCylinder);
+        auto radius = [=](const Vec3d& x) {
+            return w.isCylinder ? std::hypot(x[0] + w.centre[0], x[1]) : norm(add(x, w.centre));
+        };
+        // How far past the surface the stems leave by (the outside of the limb, the inside of the knob).
+        auto pastExit = [=](const Vec3d& x) { return w.isCylinder ? radius(x) - w.hi : w.lo - radius(x); };
+        ShellProbe probe;
+        probe.voxelMm = 1.0;
+        probe.wallMm = w.hi - w.lo;
+        probe.signedDistanceMm = [=](const Vec3d& x) { return std::max(radius(x) - w.hi, w.lo - radius(x)); };
+        probe.pieceAt = [=](const Vec3d& x) -> int64_t {
+            return radius(x) < w.lo || radius(x) > w.hi ? -1 : 0;
+        };
+        int accepted = 0;
+        for (const TenonCandidate& c : findTenonCandidates(oneBall(), Transform4d::identity(), probe, o)) {
+            const Tenon& t = c.tenon;
+            CAPTURE(t.hole);
+            if (c.rejection == "no wall within reach") continue;
+            CHECK(c.rejection.empty());
+            if (!c.rejection.empty()) continue;
+            ++accepted;
+            CHECK(t.isClipped());
+            // Nothing of the solid within 0.25 mm of the surface it leaves by (a 0.5 mm grid around
+            // the end), and solid halfway through the wall on every line of the stem's section.
+            CHECK(farthestSolid(t, o, pastExit) < -0.25);
+            int solid = 0, samples = 0;
+            const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
+            auto at = [&](double a, double fl, double fs) {
+                const double half = stemHalfWidthMm(o, a - t.shoulderMm);
+                return madd(madd(t.pointAt(a), fl * half, t.longSideGrid), fs * half, shortSide);
+            };
+            for (double fl = -0.8; fl <= 0.81; fl += 0.4)
+                for (double fs = -0.8; fs <= 0.81; fs += 0.4) {
+                    double in = -1, out = -1;  // where the line enters and leaves the wall
+                    for (double a = t.shoulderMm; a < t.endMm + 10 && out < 0; a += 0.05) {
+                        const double phi = probe.signedDistanceMm(at(a, fl, fs));
+                        if (phi < 0 && in < 0) in = a;
+                        if (phi > 0 && in > 0) out = a;
+                    }
+                    if (out < 0) continue;
+                    ++samples;
+                    solid += tenonSignedDistanceMm(t, o, at(0.5 * (in + out), fl, fs)) < 0 ? 1 : 0;
+                }
+            CHECK(samples == 25);
+            CHECK(solid == samples);
+        }
+        CHECK(accepted == w.rays);
+    }
 }
 
 TEST_CASE("tenons: the choice keeps to each piece's direction, spreads the tenons, keeps prisms apart") {

@@ -617,6 +617,54 @@ TEST_CASE("pieces: the same result with 1 and 2 threads, and the written files")
     CHECK(entries == 0);  // no staging directory left
 }
 
+TEST_CASE("pieces.json: a stem cut through a thin wall reads back; a malformed cut is refused") {
+    const partition::PartitionResult cells = quadrantCells(-15.3, 20.4);
+    PiecesOptions o;
+    o.tenons.maxTiltDeg = 35;
+    Pieces made = makePieces(shell(), frame(), Transform4d::identity(), cells, printerOf({200, 200, 200}), o,
+                             RunContext::silent());
+    Tenon* cut = nullptr;
+    for (Piece& p : made.pieces)
+        if (!p.tenons.empty()) cut = &p.tenons.front();
+    REQUIRE(cut != nullptr);
+    // A cut that slants across the section, as on a wall met obliquely.
+    cut->isCut = true;
+    for (int k = 0; k < kCutLines; ++k) cut->cutAlongMm[size_t(k)] = cut->baseMm + 1.0 + 0.05 * k;
+    cut->endMm = cut->baseMm + 3.0;
+    const PiecesJsonInfo info{"shell.vdb", "frame.json", "partition.json"};
+    const nlohmann::json j = piecesToJson(made, info);
+    const Pieces back = piecesFromJson(j, "");
+    bool seen = false;
+    for (const Piece& p : back.pieces)
+        for (const Tenon& t : p.tenons)
+            if (t.isClipped()) {
+                seen = true;
+                for (int k = 0; k < kCutLines; ++k)
+                    CHECK(t.cutAlongMm[size_t(k)] ==
+                          doctest::Approx(cut->cutAlongMm[size_t(k)]).epsilon(1e-9));
+            }
+    CHECK(seen);
+    // The wrong number of points, and a point off the stem (past its end): one line naming the field.
+    auto withCut = [&](auto edit) {
+        nlohmann::json bad = j;
+        for (nlohmann::json& p : bad["pieces"])
+            for (nlohmann::json& t : p["tenons"])
+                if (t.contains("cut_mm")) edit(t["cut_mm"]);
+        return bad;
+    };
+    const nlohmann::json fewer = withCut([](nlohmann::json& c) { c.erase(c.size() - 1); });
+    CHECK_THROWS_WITH_AS(piecesFromJson(fewer, ""), doctest::Contains("cut_mm must be an array of 25 points"),
+                         Error);
+    nlohmann::json older = j;  // a stem cut by a plane, before 2026-12-05
+    for (nlohmann::json& p : older["pieces"])
+        for (nlohmann::json& t : p["tenons"])
+            if (t.contains("cut_mm")) t["cut_plane"] = {{"normal", {1, 0, 0}}, {"offset_mm", 90.0}};
+    CHECK_THROWS_WITH_AS(piecesFromJson(older, ""), doctest::Contains("cut_plane is from an older zomefab"),
+                         Error);
+    const nlohmann::json far = withCut([](nlohmann::json& c) { c[3] = {1e6, 0, 0}; });
+    CHECK_THROWS_WITH_AS(piecesFromJson(far, ""), doctest::Contains("cut_mm[3] must lie on the stem"), Error);
+}
+
 TEST_CASE("pieces: two pieces merged into one keep every voxel, and the others are numbered down") {
     QuadrantPieces q = quadrantPieces();
     VoxelField& field = q.field;

@@ -48,6 +48,32 @@ json installationToJson(const mount::InstallationPlan& plan) {
             {"problems", plan.problems}};
 }
 
+/// One tenon of pieces.json: its axis, ball and the points along it; a stem cut through a thin
+/// wall adds where its 5 × 5 lines are cut (tenons.h, Tenon::cutAlongMm), as points.
+json tenonToJson(const Tenon& t, const TenonOptions& o) {
+    json j = {{"ball", t.ball},
+              {"hole", t.hole},
+              {"axis_frame", toJson(t.axisFrame)},
+              {"axis_mm", toJson(t.axisGrid)},
+              {"peg_long_side_mm", toJson(t.longSideGrid)},
+              {"ball_center_mm", toJson(t.ballCenterGridMm)},
+              {"peg_tip_mm", toJson(t.pointAt(t.pegTipMm))},
+              {"shoulder_mm", toJson(t.pointAt(t.shoulderMm))},
+              {"base_mm", toJson(t.pointAt(t.baseMm))},
+              {"end_mm", toJson(t.pointAt(t.endMm))},
+              {"length_mm", t.lengthMm()},
+              {"tilt_deg", t.tiltDeg}};
+    if (t.isClipped()) {
+        json points = json::array();
+        for (int i = 0; i < kCutSide; ++i)
+            for (int k = 0; k < kCutSide; ++k)
+                points.push_back(toJson(stemPointMm(t, o, t.cutAlongMm[size_t(i * kCutSide + k)],
+                                                    cutLineFraction(i), cutLineFraction(k))));
+        j["cut_mm"] = std::move(points);
+    }
+    return j;
+}
+
 }  // namespace
 
 std::string pieceName(const Pieces& pieces, size_t index) {
@@ -119,23 +145,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
         for (const auto& [id, area] : p.neighbors)
             neighbors.push_back({{"piece", id}, {"contact_mm2", area}});
         json tenons = json::array();
-        for (const Tenon& t : p.tenons) {
-            tenons.push_back({{"ball", t.ball},
-                              {"hole", t.hole},
-                              {"axis_frame", toJson(t.axisFrame)},
-                              {"axis_mm", toJson(t.axisGrid)},
-                              {"peg_long_side_mm", toJson(t.longSideGrid)},
-                              {"ball_center_mm", toJson(t.ballCenterGridMm)},
-                              {"peg_tip_mm", toJson(t.pointAt(t.pegTipMm))},
-                              {"shoulder_mm", toJson(t.pointAt(t.shoulderMm))},
-                              {"base_mm", toJson(t.pointAt(t.baseMm))},
-                              {"end_mm", toJson(t.pointAt(t.endMm))},
-                              {"length_mm", t.lengthMm()},
-                              {"tilt_deg", t.tiltDeg}});
-            if (t.isClipped())
-                tenons.back()["cut_plane"] = {{"normal", toJson(t.clipNormalGrid)},
-                                              {"offset_mm", t.clipOffsetMm}};
-        }
+        for (const Tenon& t : p.tenons) tenons.push_back(tenonToJson(t, o.tenons));
         json pins = json::array();
         for (const AlignmentPin& pin : p.pins)
             pins.push_back({{"partner", pin.partner},

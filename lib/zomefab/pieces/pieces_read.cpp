@@ -89,12 +89,22 @@ Tenon tenonFromJson(const json& j, uint32_t piece, const std::string& what) {
     t.baseMm = along("base_mm");
     t.endMm = along("end_mm");
     t.tiltDeg = numberFromJson(requireMember(j, "tilt_deg", what), what + ".tilt_deg");
-    if (j.contains("cut_plane")) {
-        const json& c = j.at("cut_plane");
-        const std::string where = what + ".cut_plane";
-        t.clipNormalGrid = vec3FromJson(requireMember(c, "normal", where), where + ".normal");
-        if (!(std::abs(norm(t.clipNormalGrid) - 1.0) < 1e-3)) fail(where + ".normal must be a unit vector");
-        t.clipOffsetMm = numberFromJson(requireMember(c, "offset_mm", where), where + ".offset_mm");
+    if (j.contains("cut_plane"))  // written before stems were cut along the outer surface
+        fail(what + ".cut_plane is from an older zomefab (a stem cut by a plane): make the pieces again");
+    if (j.contains("cut_mm")) {
+        // The 5 × 5 points where the stem's lines are cut: only how far along the axis each lies
+        // is kept (the line fixes the rest).
+        const json& c = j.at("cut_mm");
+        const std::string where = what + ".cut_mm";
+        if (!c.is_array() || c.size() != size_t(kCutLines))
+            fail(where + " must be an array of " + std::to_string(kCutLines) + " points");
+        for (size_t k = 0; k < c.size(); ++k) {
+            const std::string at = where + "[" + std::to_string(k) + "]";
+            t.cutAlongMm[k] = dot(sub(vec3FromJson(c[k], at), t.ballCenterGridMm), t.axisGrid);
+            if (!(t.cutAlongMm[k] >= t.shoulderMm && t.cutAlongMm[k] <= t.endMm))
+                fail(at + " must lie on the stem, between its shoulder and its end");
+        }
+        t.isCut = true;
     }
     return t;
 }

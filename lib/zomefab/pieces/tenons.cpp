@@ -80,108 +80,132 @@ Tenon tenonAlong(const zome::Structure& frame, zome::BallId id, int hole, const 
     return t;
 }
 
-/// A point of the stem's section @p a mm along the axis, at fractions @p fl, @p fs (−1..1) of its
-/// half-width along the long and the short side.
-Vec3d sectionPoint(const Tenon& t, const TenonOptions& o, double a, double fl, double fs) {
-    const double half = stemHalfWidthMm(o, a - t.shoulderMm);
-    const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
-    return add(t.pointAt(a), add(scale(t.longSideGrid, fl * half), scale(shortSide, fs * half)));
-}
-
-/// Where the stem's line at section fractions (fl, fs) meets a cut stem's plane (bisection; the
-/// line's start is on the printed side, its end, t.endMm, past the plane).
-Vec3d cutFacePoint(const Tenon& t, const TenonOptions& o, double fl, double fs) {
-    double in = t.shoulderMm, past = t.endMm;
-    for (int k = 0; k < 30; ++k) {
-        const double mid = 0.5 * (in + past);
-        (t.beyondClipMm(sectionPoint(t, o, mid, fl, fs)) > 0 ? past : in) = mid;
+/// The crossing of the shell's surface on the stem's line at (@p fl, @p fs) between @p outMm
+/// (φ ≥ 0) and @p inMm (φ < 0), mm along the axis (bisection to 10⁻⁷ of the interval).
+double bisectAlong(const Tenon& t, const ShellProbe& probe, const TenonOptions& o, double fl, double fs,
+                   double outMm, double inMm) {
+    for (int i = 0; i < 24; ++i) {
+        const double mid = 0.5 * (outMm + inMm);
+        (probe.signedDistanceMm(stemPointMm(t, o, mid, fl, fs)) < 0 ? inMm : outMm) = mid;
     }
-    return sectionPoint(t, o, in, fl, fs);
+    return 0.5 * (outMm + inMm);
 }
 
-/// 5 × 5 fractions across the stem's section, corners included.
-constexpr int kLateral = 4;
-double lateralFraction(int i) { return -1.0 + 2.0 * i / kLateral; }
+/// How one of the lines of a cut stem meets the wall before the cut.
+enum class CutLine {
+    InCavity,      ///< cut before it reaches the wall: it ends in the object's hollow, unseen
+    Bonded,        ///< runs half a voxel or more through this piece's wall and ends in it, a skin in
+    ShowsThrough,  ///< leaves the wall through the outer surface, or ends within a skin of it
+    OtherPiece,    ///< runs through another piece's wall
+};
 
-/// For a stem a thin wall cannot bury (tenonCandidate): where the axis leaves the wall through the
-/// outer surface, the cut plane parallel to that surface kOuterSkinMm inside it, and the stem's
-/// end past the plane at every corner. False when the axis does not leave the wall within reach,
-/// leaves it too obliquely (a cut face beyond 70° of the axis would be a long sliver), or the
-/// plane leaves less than half a voxel of stem in the wall.
-bool clipThroughWall(Tenon& t, double hit, const ShellProbe& probe, const TenonOptions& o) {
+/// Where the line at (@p fl, @p fs) first enters the wall, mm along the axis; −1 when it does not
+/// before @p untilMm.
+double entryAlongMm(const Tenon& t, const ShellProbe& probe, const TenonOptions& o, double fl, double fs,
+                    double untilMm) {
     const double step = 0.5 * probe.voxelMm;
-    const double reach = hit + 4.0 * probe.wallMm + 2.0 * probe.voxelMm;
-    double out = -1;
-    for (double s = hit + step; s <= reach && out < 0; s += step)
-        if (probe.signedDistanceMm(t.pointAt(s)) >= 0)
-            out = bisect(probe, t.ballCenterGridMm, t.axisGrid, s, s - step);
-    if (out < 0) return false;
-    const Vec3d m = probe.normalAt(t.pointAt(out));
-    const double cosOut = dot(m, t.axisGrid);
-    if (!(cosOut > std::cos(70.0 * kPi / 180.0))) return false;
-    t.clipNormalGrid = m;
-    t.clipOffsetMm = dot(m, t.pointAt(out)) - kOuterSkinMm;
-    // The stem must still reach half a voxel into the wall along its axis.
-    auto isInWall = [&] {
-        if (t.clipAlongAxisMm() >= hit + step) return true;
-        t.clipNormalGrid = {0, 0, 0};
-        return false;
-    };
-    if (!isInWall()) return false;
-    const double plane = t.clipAlongAxisMm();
-    // Every corner of the end face beyond the plane: the corner nearest the plane trails the
-    // axis by half·(|m·l| + |m·s|)/cosOut; the half-width grows with the taper, so iterate.
-    const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
-    const double spread = std::abs(dot(m, t.longSideGrid)) + std::abs(dot(m, shortSide));
-    double end = plane;
-    for (int i = 0; i < 4; ++i) end = plane + stemHalfWidthMm(o, end - t.shoulderMm) * spread / cosOut + 0.5;
-    t.endMm = end;
-    // A curved outer surface leaves the tangent plane: move the plane in until the whole cut
-    // face keeps kCutSkinMm of wall (the corners stay past it), as long as the stem still
-    // reaches into the wall.
-    for (int round = 0; round < 3; ++round) {
-        double worst = -1e30;
-        for (int i = 0; i <= kLateral; ++i)
-            for (int j = 0; j <= kLateral; ++j)
-                worst = std::max(worst, probe.signedDistanceMm(
-                                            cutFacePoint(t, o, lateralFraction(i), lateralFraction(j))) +
-                                            kCutSkinMm);
-        if (worst <= 0) break;
-        t.clipOffsetMm -= worst + 0.1;
+    for (double a = t.shoulderMm; a <= untilMm; a += step)
+        if (probe.signedDistanceMm(stemPointMm(t, o, a, fl, fs)) < 0)
+            return a == t.shoulderMm ? a : bisectAlong(t, probe, o, fl, fs, a - step, a);
+    return -1;
+}
+
+/// The line at (@p fl, @p fs) of cut stem @p t, which enters the wall at @p entryMm (−1: not
+/// within reach), against the cut.
+CutLine cutLine(const Tenon& t, int64_t piece, const ShellProbe& probe, const TenonOptions& o, double fl,
+                double fs, double entryMm) {
+    const double step = 0.5 * probe.voxelMm;
+    const double cutMm = t.cutAlongAtMm(fl, fs);
+    if (entryMm < 0 || entryMm >= cutMm) return CutLine::InCavity;
+    // From the entry to the cut it stays in this piece's wall: leaving it there can only be
+    // through the outer surface (or into a neighbour's wall).
+    for (double a = entryMm + 0.25 * step; a < cutMm; a += step) {
+        const Vec3d q = stemPointMm(t, o, a, fl, fs);
+        if (probe.signedDistanceMm(q) >= 0) return CutLine::ShowsThrough;
+        if (probe.pieceAt(q) != piece) return CutLine::OtherPiece;
     }
-    return isInWall();
+    const Vec3d e = stemPointMm(t, o, cutMm, fl, fs);
+    const double phi = probe.signedDistanceMm(e);
+    if (!(phi < 0)) return CutLine::ShowsThrough;
+    if (probe.pieceAt(e) != piece) return CutLine::OtherPiece;
+    // The nearest surface is the outer one where the material's outward normal runs with the axis
+    // (the inner one faces the ball): there the cut keeps kCutSkinMm of wall.
+    if (phi > -kCutSkinMm && dot(probe.normalAt(e), t.axisGrid) > 0) return CutLine::ShowsThrough;
+    return cutMm - entryMm >= step ? CutLine::Bonded : CutLine::InCavity;
+}
+
+/// For a stem a thin wall cannot bury (tenonCandidate): each of its kCutSide × kCutSide lines runs
+/// into the wall and is cut kOuterSkinMm (across the wall) before it leaves it through the outer
+/// surface, so the cut follows the outer surface however it curves, and the stem bonds across the
+/// wall's whole thickness. False when a line reaches no wall (a piece's edge, an opening), the
+/// centre line or a third of the lines reach it too shallowly to bond (half a voxel), a line leaves the wall
+/// more than 70° off the outer surface's normal (the cut would be a long sliver), or a line between them
+/// would show through (cutLine, at twice the density).
+bool clipThroughWall(Tenon& t, int64_t piece, double hit, const ShellProbe& probe, const TenonOptions& o) {
+    const double step = 0.5 * probe.voxelMm;
+    const double reach = hit + 4.0 * probe.wallMm + 2.0 * probe.voxelMm + 2.0 * stemHalfWidthMm(o, hit);
+    const double minCos = std::cos(70.0 * kPi / 180.0);
+    int bonded = 0;
+    for (int i = 0; i < kCutSide; ++i)
+        for (int j = 0; j < kCutSide; ++j) {
+            const double fl = cutLineFraction(i), fs = cutLineFraction(j);
+            double& cut = t.cutAlongMm[size_t(i * kCutSide + j)];
+            const double entry = entryAlongMm(t, probe, o, fl, fs, reach);
+            if (entry < 0) return false;  // past a piece's edge or an opening
+            double out = -1;
+            for (double a = entry + step; a <= reach && out < 0; a += step)
+                if (probe.signedDistanceMm(stemPointMm(t, o, a, fl, fs)) >= 0)
+                    out = bisectAlong(t, probe, o, fl, fs, a, a - step);
+            if (out < 0) return false;
+            const double cosOut = dot(probe.normalAt(stemPointMm(t, o, out, fl, fs)), t.axisGrid);
+            if (!(cosOut > minCos)) return false;
+            cut = out - kOuterSkinMm / cosOut;
+            bonded += cut - entry >= step ? 1 : 0;
+        }
+    const double centre = t.cutAlongMm[kCutLines / 2];
+    if (!(centre - hit >= step) || 3 * bonded < 2 * kCutLines) return false;
+    t.isCut = true;
+    t.endMm = *std::max_element(t.cutAlongMm.begin(), t.cutAlongMm.end()) + 0.5;
+    // Between the lines the cut is bilinear: on a wall curved more than the lines can follow, a
+    // point between them could show through.
+    for (int i = 0; i <= 2 * (kCutSide - 1); ++i)
+        for (int j = 0; j <= 2 * (kCutSide - 1); ++j) {
+            const double fl = -1.0 + double(i) / (kCutSide - 1), fs = -1.0 + double(j) / (kCutSide - 1);
+            const double entry = entryAlongMm(t, probe, o, fl, fs, t.cutAlongAtMm(fl, fs));
+            const CutLine line = cutLine(t, piece, probe, o, fl, fs, entry);
+            if (line == CutLine::ShowsThrough) {
+                t.isCut = false;
+                return false;
+            }
+        }
+    return true;
 }
 
 /// The prism stays in its piece: wherever it is inside the shell it is this piece's, and its end
-/// face lies in this piece's wall with at least half a voxel of wall beyond. The rejection, or empty.
+/// face (of a stem not cut) lies in this piece's wall with at least half a voxel of wall beyond.
+/// The rejection, or empty.
 std::string containment(const Tenon& t, int64_t piece, const ShellProbe& probe, const TenonOptions& o) {
     const double step = 0.5 * probe.voxelMm;
     int endInWall = 0, endSamples = 0;
     bool isCentreIn = false;
-    for (int i = 0; i <= kLateral; ++i)
-        for (int j = 0; j <= kLateral; ++j) {
-            const double fl = lateralFraction(i), fs = lateralFraction(j);
-            auto at = [&](double a) { return sectionPoint(t, o, a, fl, fs); };
+    for (int i = 0; i < kCutSide; ++i)
+        for (int j = 0; j < kCutSide; ++j) {
+            const double fl = cutLineFraction(i), fs = cutLineFraction(j);
+            auto at = [&](double a) { return stemPointMm(t, o, a, fl, fs); };
             for (double a = t.shoulderMm; a <= t.endMm + 1e-9; a += step) {
                 const Vec3d q = at(a);
-                if (t.beyondClipMm(q) > 0) break;
+                if (beyondCutMm(t, o, q) > 0) break;
                 if (probe.signedDistanceMm(q) < 0 && probe.pieceAt(q) != piece)
                     return "crosses another piece";
             }
-            if (t.isClipped()) {
-                // The cut face, where this sample line meets the plane, must lie in this piece's
-                // wall with skin to spare: on a curved outer surface the plane, a tangent, would
-                // otherwise show through.
-                const Vec3d e = cutFacePoint(t, o, fl, fs);
-                if (!(probe.signedDistanceMm(e) < -kCutSkinMm && probe.pieceAt(e) == piece))
-                    return "the stem would show through a curved wall";
-                continue;
-            }
+            // A cut stem's lines were followed to the cut by clipThroughWall: none shows
+            // through, the centre and two thirds of them bond.
+            if (t.isClipped()) continue;
             const Vec3d e = at(t.endMm);
             const bool isIn = probe.signedDistanceMm(e) < -0.5 * probe.voxelMm && probe.pieceAt(e) == piece;
             endInWall += isIn ? 1 : 0;
             ++endSamples;
-            if (i == kLateral / 2 && j == kLateral / 2) isCentreIn = isIn;
+            if (i == kCutSide / 2 && j == kCutSide / 2) isCentreIn = isIn;
         }
     if (t.isClipped()) return "";
     // The end face bonds to the wall: its centre and most of it (a tilted thin wall may leave a
@@ -234,7 +258,7 @@ TenonCandidate tenonCandidate(const zome::Structure& frame, zome::BallId id, int
     t.endMm = hit + o.embedMm + r * tanTilt;
     // A wall too thin to bury the square end: the stem goes on through it, cut parallel to the
     // outer surface (clipThroughWall), so it bonds across the wall's whole thickness.
-    if (deepest < t.endMm && !clipThroughWall(t, hit, probe, o)) {
+    if (deepest < t.endMm && !clipThroughWall(t, c.piece, hit, probe, o)) {
         t.endMm = deepest;  // buried as deep as the wall allows, the end face partly in it
         if (t.endMm < hit + 0.5 * probe.voxelMm) return c.rejection = "surface too oblique for the wall", c;
     }
@@ -323,7 +347,40 @@ double tenonSignedDistanceMm(const Tenon& t, const TenonOptions& o, const Vec3d&
     // distances off it are within 1/cos(taper) of the true ones.
     const double half = stemHalfWidthMm(o, std::clamp(a, start, t.endMm) - t.shoulderMm);
     const double prism = boxDistance({a - bodyMid, l, s}, {bodyHalf, half, half});
-    return t.isClipped() ? std::max(prism, t.beyondClipMm(p)) : prism;
+    if (!t.isClipped()) return prism;
+    // beyondCutMm runs along the axis; across a cut that slants over the section it overstates the
+    // distance by the slope's √(1 + |∇h|²) (h: the cut's height over the section, mm per mm).
+    const double fl = l / half, fs = s / half, dh = 0.05;
+    const double slopeL = (t.cutAlongAtMm(fl + dh, fs) - t.cutAlongAtMm(fl - dh, fs)) / (2 * dh * half);
+    const double slopeS = (t.cutAlongAtMm(fl, fs + dh) - t.cutAlongAtMm(fl, fs - dh)) / (2 * dh * half);
+    const double beyond = (a - t.cutAlongAtMm(fl, fs)) / std::sqrt(1.0 + slopeL * slopeL + slopeS * slopeS);
+    return std::max(prism, beyond);
+}
+
+Vec3d stemPointMm(const Tenon& t, const TenonOptions& o, double alongMm, double fl, double fs) {
+    const double half = stemHalfWidthMm(o, alongMm - t.shoulderMm);
+    const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
+    return add(t.pointAt(alongMm), add(scale(t.longSideGrid, fl * half), scale(shortSide, fs * half)));
+}
+
+double beyondCutMm(const Tenon& t, const TenonOptions& o, const Vec3d& p) {
+    if (!t.isClipped()) return -1e30;
+    const Vec3d d = sub(p, t.ballCenterGridMm);
+    const double a = dot(d, t.axisGrid);
+    const double half = stemHalfWidthMm(o, a - t.shoulderMm);
+    const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
+    return a - t.cutAlongAtMm(dot(d, t.longSideGrid) / half, dot(d, shortSide) / half);
+}
+
+double Tenon::cutAlongAtMm(double fl, double fs) const {
+    const double top = kCutSide - 1;
+    const double u = std::clamp(0.5 * (fl + 1.0) * top, 0.0, top),
+                 v = std::clamp(0.5 * (fs + 1.0) * top, 0.0, top);
+    const int i = std::min(int(u), kCutSide - 2), j = std::min(int(v), kCutSide - 2);
+    const double du = u - i, dv = v - j;
+    auto h = [&](int a, int b) { return cutAlongMm[size_t(a * kCutSide + b)]; };
+    return (1 - du) * ((1 - dv) * h(i, j) + dv * h(i, j + 1)) +
+           du * ((1 - dv) * h(i + 1, j) + dv * h(i + 1, j + 1));
 }
 
 TriMesh pegMesh(const Tenon& t, const TenonOptions& o) {
@@ -367,10 +424,10 @@ std::vector<Vec3d> tenonHullMm(const Tenon& t, const TenonOptions& o) {
     const double start = t.shoulderMm + kPrismGapMm;
     corners(start, stemHalfWidthMm(o, start - t.shoulderMm));
     corners(t.endMm, stemHalfWidthMm(o, t.endMm - t.shoulderMm));
-    if (t.isClipped())  // each side edge ends on the cut plane (every end corner lies past it)
+    if (t.isClipped())  // each side edge ends on the cut
         for (size_t k = 4; k < 8; ++k) {
-            const double fa = t.beyondClipMm(out[k - 4]), fb = t.beyondClipMm(out[k]);
-            if (fb > 0 && fa < 0) out[k] = add(out[k - 4], scale(sub(out[k], out[k - 4]), fa / (fa - fb)));
+            const double fl = k < 6 ? -1.0 : 1.0, fs = k % 2 == 0 ? -1.0 : 1.0;
+            out[k] = stemPointMm(t, o, t.cutAlongAtMm(fl, fs), fl, fs);
         }
     for (const auto& q : pegSectionMm(t.hole, o))
         out.push_back(madd(madd(t.pointAt(t.pegTipMm), q[0], t.longSideGrid), q[1], shortSide));
@@ -380,6 +437,13 @@ std::vector<Vec3d> tenonHullMm(const Tenon& t, const TenonOptions& o) {
 Box3d tenonBoundsMm(const Tenon& t, const TenonOptions& o) {
     Box3d box;
     for (const Vec3d& p : tenonHullMm(t, o)) box.expand(p);
+    if (t.isClipped()) {  // a cut that bulges between the corners stays short of the end face
+        const double half = stemHalfWidthMm(o, t.endMm - t.shoulderMm);
+        const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
+        for (const double l : {-half, half})
+            for (const double s : {-half, half})
+                box.expand(madd(madd(t.pointAt(t.endMm), l, t.longSideGrid), s, shortSide));
+    }
     return box;
 }
 

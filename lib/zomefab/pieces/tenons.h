@@ -54,7 +54,8 @@ struct TenonOptions {
     double maxLengthMm = 60.0;
     /// Largest angle between the tenon's axis and the inner surface's normal (§6.1: "perpendicular").
     /// The prism's end is buried deeper on a tilted wall (r·tan(tilt) more), so the bond does not
-    /// suffer; a wall too thin to bury it refuses the ray ("surface too oblique for the wall"). All
+    /// suffer; through a wall too thin to bury it the stem runs on and is cut a skin inside the
+    /// outer surface (Tenon::cutAlongMm), or the ray is refused ("surface too oblique for the wall"). All
     /// pegs of a piece share its direction, so on limbs and round bodies most walls meet it
     /// obliquely: 60° instead of 35° puts 9 more of the 73 pieces of the armadillo, the
     /// elephant and the dino at 400–500 mm on two pegs (docs/pieces.md).
@@ -83,6 +84,12 @@ double bodyRadiusMm(const TenonOptions& o);
 /// Half the stem's side @p fromFaceMm from the ball's face (the taper), mm.
 double stemHalfWidthMm(const TenonOptions& o, double fromFaceMm);
 
+/// A cut stem's lines (Tenon::cutAlongMm): kCutSide × kCutSide across its section, corners
+/// included, at fractions −1, −½, 0, ½, 1 of its half-width.
+inline constexpr int kCutSide = 5;
+inline constexpr int kCutLines = kCutSide * kCutSide;
+inline double cutLineFraction(int i) { return -1.0 + 2.0 * i / (kCutSide - 1); }
+
 /// One tenon. Distances are along the axis from the ball's centre, in mm.
 struct Tenon {
     zome::BallId ball = zome::kNoId;
@@ -98,20 +105,19 @@ struct Tenon {
     double pegTipMm = 0.0;    ///< the peg's end in the hole: shoulderMm − pegDepthMm
     double tiltDeg = 0.0;     ///< angle between the axis and the inner surface's normal
     /// A wall too thin to bury the stem's square end (a thin wall met obliquely): the stem runs
-    /// on through the wall and is cut by a plane parallel to the outer surface, a skin inside it;
-    /// points x with dot(clipNormalGrid, x) > clipOffsetMm are not printed. Zero normal: no cut.
-    Vec3d clipNormalGrid{0, 0, 0};
-    double clipOffsetMm = 0.0;
+    /// on through the wall and is cut a skin inside the outer surface, along a surface that
+    /// follows it. cutAlongMm[i·kCutSide + j]: where the stem's line at fractions
+    /// (cutLineFraction(i), cutLineFraction(j)) of its half-width (long side, short side) is cut,
+    /// mm along the axis from the ball's centre; bilinear between the lines (cutAlongAtMm).
+    bool isCut = false;
+    std::array<double, kCutLines> cutAlongMm{};
 
-    bool isClipped() const { return dot(clipNormalGrid, clipNormalGrid) > 0.0; }
-    /// How far @p p lies beyond the cut plane (mm; negative: on the printed side, or no cut).
-    double beyondClipMm(const Vec3d& p) const {
-        return isClipped() ? dot(clipNormalGrid, p) - clipOffsetMm : -1e30;
-    }
-    /// Where the axis meets the cut plane, mm from the ball's centre (a cut tenon only).
-    double clipAlongAxisMm() const {
-        return (clipOffsetMm - dot(clipNormalGrid, ballCenterGridMm)) / dot(clipNormalGrid, axisGrid);
-    }
+    bool isClipped() const { return isCut; }
+    /// Where the cut meets the stem's line at fractions @p fl, @p fs ∈ [−1, 1] of its half-width
+    /// (clamped), mm along the axis: bilinear in cutAlongMm.
+    double cutAlongAtMm(double fl, double fs) const;
+    /// Where the axis meets the cut, mm from the ball's centre (a cut tenon only).
+    double clipAlongAxisMm() const { return cutAlongMm[kCutLines / 2]; }
 
     double lengthMm() const { return baseMm - shoulderMm; }
     Vec3d pointAt(double t) const {
@@ -119,6 +125,15 @@ struct Tenon {
                 ballCenterGridMm[2] + t * axisGrid[2]};
     }
 };
+
+/// The point of stem @p t's line at fractions @p fl, @p fs (−1..1) of its half-width along the long
+/// and the short side, @p alongMm along the axis from the ball's centre (the lines spread with the
+/// taper), grid mm.
+Vec3d stemPointMm(const Tenon& t, const TenonOptions& options, double alongMm, double fl, double fs);
+
+/// How far @p pGridMm lies beyond cut stem @p t's cut, mm along the axis (negative: on the printed
+/// side); −1e30 for a stem not cut.
+double beyondCutMm(const Tenon& t, const TenonOptions& options, const Vec3d& pGridMm);
 
 /// The peg's section for @p hole: its hole's section (zome::holeSectionMm) inset by the clearance,
 /// in the section's frame (x along longSideGrid, y = axis × x), mm.
