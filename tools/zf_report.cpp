@@ -34,6 +34,9 @@ int main(int argc, char** argv) {
     costCli.addTo(app);
 
     return tool.run(argc, argv, [&](nlohmann::json& report) {
+        // Checked before the work (with --slicer, half an hour), not when the files are written.
+        for (const char* name : {"/assembly.md", "/assembly.html", "/cost.md"})
+            checkOutputPath(outDir + name);
         const mesh::ScaleOptions scale = scaleCli.resolve();
         Fabrication fabrication = fabricationCli.resolve(tool.common().seed);
         const report::CostOptions costOptions = costCli.resolve();

@@ -61,6 +61,14 @@ TEST_CASE("tools: the chain of small tools writes the same bytes as zomefab run 
                            kScale + " -q -o " + c + "preview.glb --viewer " + c + "viewer.html") == 0);
     REQUIRE(test::runShell(tool("zf-report") + kMesh + " " + c + "frame.json " + c + "pieces" + kScale +
                            " -q -o " + chain) == 0);
+    // An output directory that does not exist is refused before any work: one line naming it, exit 4,
+    // no progress of the report stage.
+    const std::string said = dir.file("missing.txt");
+    CHECK(test::runShell(tool("zf-report") + kMesh + " " + c + "frame.json " + c + "pieces" + kScale +
+                         " -o " + dir.file("no-such-dir") + " 2> " + said) == 4);
+    const std::string message = test::readFile(said);
+    CHECK(message.find("no-such-dir/assembly.md: directory does not exist") != std::string::npos);
+    CHECK(message.find("[report]") == std::string::npos);
     fs::rename(c + "pieces/plates", c + "plates");
 
     size_t compared = 0;
