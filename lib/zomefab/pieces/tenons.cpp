@@ -91,14 +91,6 @@ double bisectAlong(const Tenon& t, const ShellProbe& probe, const TenonOptions& 
     return 0.5 * (outMm + inMm);
 }
 
-/// How one of the lines of a cut stem meets the wall before the cut.
-enum class CutLine {
-    InCavity,      ///< cut before it reaches the wall: it ends in the object's hollow, unseen
-    Bonded,        ///< runs half a voxel or more through this piece's wall and ends in it, a skin in
-    ShowsThrough,  ///< leaves the wall through the outer surface, or ends within a skin of it
-    OtherPiece,    ///< runs through another piece's wall
-};
-
 /// Where the line at (@p fl, @p fs) first enters the wall, mm along the axis; −1 when it does not
 /// before @p untilMm.
 double entryAlongMm(const Tenon& t, const ShellProbe& probe, const TenonOptions& o, double fl, double fs,
@@ -110,28 +102,27 @@ double entryAlongMm(const Tenon& t, const ShellProbe& probe, const TenonOptions&
     return -1;
 }
 
-/// The line at (@p fl, @p fs) of cut stem @p t, which enters the wall at @p entryMm (−1: not
-/// within reach), against the cut.
-CutLine cutLine(const Tenon& t, int64_t piece, const ShellProbe& probe, const TenonOptions& o, double fl,
-                double fs, double entryMm) {
+/// Whether the line at (@p fl, @p fs) of cut stem @p t, which enters the wall at @p entryMm (−1: not
+/// within reach), shows through: it leaves the wall before the cut (through the outer surface), or
+/// its cut lies within kCutSkinMm of the outer surface. A line cut before the wall ends in the
+/// hollow, unseen; one that runs into another piece's wall is containment's "crosses another piece".
+bool showsThrough(const Tenon& t, int64_t piece, const ShellProbe& probe, const TenonOptions& o, double fl,
+                  double fs, double entryMm) {
     const double step = 0.5 * probe.voxelMm;
     const double cutMm = t.cutAlongAtMm(fl, fs);
-    if (entryMm < 0 || entryMm >= cutMm) return CutLine::InCavity;
-    // From the entry to the cut it stays in this piece's wall: leaving it there can only be
-    // through the outer surface (or into a neighbour's wall).
+    if (entryMm < 0 || entryMm >= cutMm) return false;
     for (double a = entryMm + 0.25 * step; a < cutMm; a += step) {
         const Vec3d q = stemPointMm(t, o, a, fl, fs);
-        if (probe.signedDistanceMm(q) >= 0) return CutLine::ShowsThrough;
-        if (probe.pieceAt(q) != piece) return CutLine::OtherPiece;
+        if (probe.signedDistanceMm(q) >= 0) return true;
+        if (probe.pieceAt(q) != piece) return false;
     }
     const Vec3d e = stemPointMm(t, o, cutMm, fl, fs);
     const double phi = probe.signedDistanceMm(e);
-    if (!(phi < 0)) return CutLine::ShowsThrough;
-    if (probe.pieceAt(e) != piece) return CutLine::OtherPiece;
+    if (!(phi < 0)) return true;
+    if (probe.pieceAt(e) != piece) return false;
     // The nearest surface is the outer one where the material's outward normal runs with the axis
     // (the inner one faces the ball): there the cut keeps kCutSkinMm of wall.
-    if (phi > -kCutSkinMm && dot(probe.normalAt(e), t.axisGrid) > 0) return CutLine::ShowsThrough;
-    return cutMm - entryMm >= step ? CutLine::Bonded : CutLine::InCavity;
+    return phi > -kCutSkinMm && dot(probe.normalAt(e), t.axisGrid) > 0;
 }
 
 /// For a stem a thin wall cannot bury (tenonCandidate): each of its kCutSide × kCutSide lines runs
@@ -140,7 +131,7 @@ CutLine cutLine(const Tenon& t, int64_t piece, const ShellProbe& probe, const Te
 /// wall's whole thickness. False when a line reaches no wall (a piece's edge, an opening), the
 /// centre line or a third of the lines reach it too shallowly to bond (half a voxel), a line leaves the wall
 /// more than 70° off the outer surface's normal (the cut would be a long sliver), or a line between them
-/// would show through (cutLine, at twice the density).
+/// would show through (showsThrough, at twice the density).
 bool clipThroughWall(Tenon& t, int64_t piece, double hit, const ShellProbe& probe, const TenonOptions& o) {
     const double step = 0.5 * probe.voxelMm;
     const double reach = hit + 4.0 * probe.wallMm + 2.0 * probe.voxelMm + 2.0 * stemHalfWidthMm(o, hit);
@@ -172,8 +163,7 @@ bool clipThroughWall(Tenon& t, int64_t piece, double hit, const ShellProbe& prob
         for (int j = 0; j <= 2 * (kCutSide - 1); ++j) {
             const double fl = -1.0 + double(i) / (kCutSide - 1), fs = -1.0 + double(j) / (kCutSide - 1);
             const double entry = entryAlongMm(t, probe, o, fl, fs, t.cutAlongAtMm(fl, fs));
-            const CutLine line = cutLine(t, piece, probe, o, fl, fs, entry);
-            if (line == CutLine::ShowsThrough) {
+            if (showsThrough(t, piece, probe, o, fl, fs, entry)) {
                 t.isCut = false;
                 return false;
             }
@@ -256,7 +246,7 @@ TenonCandidate tenonCandidate(const zome::Structure& frame, zome::BallId id, int
     const double deepest =
         hit - r * tanTilt + probe.wallMm / std::cos(t.tiltDeg * kPi / 180.0) - kOuterSkinMm;
     t.endMm = hit + o.embedMm + r * tanTilt;
-    // A wall too thin to bury the square end: the stem goes on through it, cut parallel to the
+    // A wall too thin to bury the square end: the stem goes on through it, cut a skin inside the
     // outer surface (clipThroughWall), so it bonds across the wall's whole thickness.
     if (deepest < t.endMm && !clipThroughWall(t, c.piece, hit, probe, o)) {
         t.endMm = deepest;  // buried as deep as the wall allows, the end face partly in it
@@ -437,13 +427,9 @@ std::vector<Vec3d> tenonHullMm(const Tenon& t, const TenonOptions& o) {
 Box3d tenonBoundsMm(const Tenon& t, const TenonOptions& o) {
     Box3d box;
     for (const Vec3d& p : tenonHullMm(t, o)) box.expand(p);
-    if (t.isClipped()) {  // a cut that bulges between the corners stays short of the end face
-        const double half = stemHalfWidthMm(o, t.endMm - t.shoulderMm);
-        const Vec3d shortSide = cross(t.axisGrid, t.longSideGrid);
-        for (const double l : {-half, half})
-            for (const double s : {-half, half})
-                box.expand(madd(madd(t.pointAt(t.endMm), l, t.longSideGrid), s, shortSide));
-    }
+    if (t.isClipped())  // a cut that bulges between the corners stays short of the end face
+        for (const double fl : {-1.0, 1.0})
+            for (const double fs : {-1.0, 1.0}) box.expand(stemPointMm(t, o, t.endMm, fl, fs));
     return box;
 }
 
