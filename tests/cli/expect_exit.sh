@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # expect_exit.sh CODE REGEX [--no-file PATH]... [--not REGEX]... -- COMMAND...
 # Runs COMMAND; fails unless it exits with CODE, its stderr matches the extended REGEX (on one line)
-# and none of the --not ones, and none of the --no-file paths exists afterwards (no partial outputs).
+# and none of the --not ones, and none of the --no-file paths exists afterwards, nor a temporary
+# of one (no partial outputs).
 set -u
 code=$1; regex=$2; shift 2
 nofiles=()
@@ -25,8 +26,12 @@ done
 for f in "${nofiles[@]+"${nofiles[@]}"}"; do
   if [ -e "$f" ]; then echo "FAIL: $f was written" >&2; status=1; fi
 done
-if ls -a "$(dirname "${nofiles[0]:-.}")" 2>/dev/null | grep -q '\.tmp[0-9]'; then
-  echo "FAIL: a temporary file was left behind" >&2; status=1
-fi
+# A temporary file is ".NAME.tmpPID" beside its target. Only the named outputs' own are looked for:
+# ctest runs other tests in the same directory at the same time, and their temporaries are theirs.
+for f in "${nofiles[@]+"${nofiles[@]}"}"; do
+  if ls -a "$(dirname "$f")" 2>/dev/null | grep -qF ".$(basename "$f").tmp"; then
+    echo "FAIL: a temporary file of $f was left behind" >&2; status=1
+  fi
+done
 echo "--- stderr:" >&2; cat "$err" >&2; rm -f "$err"
 exit $status
