@@ -89,6 +89,7 @@ int main(int argc, char** argv) {
                         partitionPath);
         if (fabricationCli.printer.empty())
             fabrication.printerMm = partition.result.printerMm;  // the partition's printer
+        fabrication.wallMm = shell.info().shellMm;               // the wall the shell was hollowed with
         const Transform4d frameToGrid = [&] {
             try {
                 return shell.info().transformMm * affineInverse(frameTransform);

@@ -143,6 +143,16 @@ TriMesh gridMesh(const Piece& piece) {
     return m;
 }
 
+const sdf::LevelSet& sphereShell() {
+    static const sdf::LevelSet s = makeSphereShell({0, 0, 0}, kSphereRadiusMm, kSphereShellMm, 1.0);
+    return s;
+}
+
+const zome::Structure& sphereFrame() {
+    static const zome::Structure s = makeCubeLattice(kSphereRadiusMm - kSphereShellMm - 8.85 - 3.0);
+    return s;
+}
+
 void writeToolInputs(const std::string& dir) {
     const sdf::LevelSet shell = makeSphereShell({0, 0, 0}, 75.0, 8.0, 1.0);
     writeFile(dir + "/shell.vdb", sdf::serializeVdb({shell}));

@@ -18,6 +18,13 @@ namespace zomefab::pieces::test {
 /// makeShell), at @p voxelMm.
 sdf::LevelSet makeSphereShell(const Vec3d& centerMm, double radiusMm, double shellMm, double voxelMm);
 
+/// The shell most pieces tests cut: a 200 mm sphere (radius kSphereRadiusMm at the origin) with an
+/// 8 mm wall (kSphereShellMm) at 1 mm voxels, built once (≈ 1 s); and the B0 lattice inside it whose
+/// balls stay 3 mm clear of the inner wall.
+inline constexpr double kSphereRadiusMm = 100.0, kSphereShellMm = 8.0;
+const sdf::LevelSet& sphereShell();
+const zome::Structure& sphereFrame();
+
 /// Balls on the B0 cube lattice (exact (2+2φ)·(i, j, k) units, b0 = 47.3 mm) whose centre lies
 /// within @p maxRadiusMm of the origin, joined by B0 struts to their lattice neighbours.
 zome::Structure makeCubeLattice(double maxRadiusMm);

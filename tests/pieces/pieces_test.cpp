@@ -41,19 +41,10 @@ using namespace zomefab::pieces::test;
 
 namespace {
 
-constexpr double kRadius = 100.0, kShell = 8.0, kVoxel = 1.0;
+constexpr double kRadius = kSphereRadiusMm, kShell = kSphereShellMm, kVoxel = 1.0;
 
-/// The shell, built once for all cases (≈ 1 s).
-const sdf::LevelSet& shell() {
-    static const sdf::LevelSet s = makeSphereShell({0, 0, 0}, kRadius, kShell, kVoxel);
-    return s;
-}
-
-/// Lattice balls whose surface stays 3 mm clear of the inner wall.
-const zome::Structure& frame() {
-    static const zome::Structure s = makeCubeLattice(kRadius - kShell - 8.85 - 3.0);
-    return s;
-}
+const sdf::LevelSet& shell() { return sphereShell(); }
+const zome::Structure& frame() { return sphereFrame(); }
 
 PiecesOptions plainOptions() {
     PiecesOptions o;

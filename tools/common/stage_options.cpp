@@ -270,6 +270,10 @@ void PiecesCli::addTo(CLI::App& app) {
     app.add_flag("--no-glue-groups", isNotGluing,
                  "Do not glue a piece fewer than --min-tenons pegs hold to a neighbour before mounting, nor print "
                  "pieces glued together as one");
+    app.add_option("--print-wall-mm", o.printWallMm,
+                   "Print each piece with this wall (mm) where its pegs reach through it; the plan and the "
+                   "frame keep --shell-mm (0 = print --shell-mm; at most 2.5 at 1 mm voxels)")
+        ->capture_default_str();
     app.add_flag("--no-label", isUnlabelled, "Do not engrave piece numbers");
     app.add_option("--label-height-mm", o.label.heightMm, "Height of the engraved digits")
         ->capture_default_str();

@@ -138,6 +138,13 @@ std::vector<std::vector<SurfaceSpot>> innerSurfaceSpots(const zome::Structure& f
     return spots;
 }
 
+LabelOptions labelOptionsForWall(const LabelOptions& options, double wallMm) {
+    LabelOptions o = options;
+    o.depthMm = std::min(o.depthMm, wallMm / 3.0);
+    o.flatnessMm = std::min(o.flatnessMm, wallMm / 6.0);
+    return o;
+}
+
 std::optional<PieceLabel> placeLabel(const std::string& text, uint32_t piece,
                                      const std::vector<SurfaceSpot>& spots, const std::vector<Tenon>& tenons,
                                      const TenonOptions& tenonOptions, const ShellProbe& probe,

@@ -42,6 +42,8 @@ void fillRegion(FloatGrid& grid, const VoxelField& field, const GridCells& cells
                 const std::vector<CellSet>& sets, const Piece& piece, const std::vector<uint32_t>& leaves,
                 double seamGapMm) {
     const float bg = field.background;
+    // A piece printed thin (thin_wall.h) is cut from the thin wall; who owns a voxel stays the shell's.
+    const std::vector<float>& phi = piece.isThinWall ? field.thinPhi : field.phi;
     const double voxel = field.voxelMm;
     std::vector<double> scores(cells.count());
     std::vector<uint32_t> others;
@@ -51,7 +53,7 @@ void fillRegion(FloatGrid& grid, const VoxelField& field, const GridCells& cells
         bool isUsed = false;
         for (uint32_t off = 0; off < kLeafSize; ++off) {
             const size_t s = size_t(leaf) * kLeafSize + off;
-            if (!field.isActive[s] || field.phi[s] >= bg) continue;
+            if (!field.isActive[s] || phi[s] >= bg) continue;
             const Vec3d x = field.world(field.coordOf(s));
             const uint32_t owner = field.owner[s];
             const bool isInside = field.isInside(s), isMember = owner == piece.id;
@@ -66,7 +68,7 @@ void fillRegion(FloatGrid& grid, const VoxelField& field, const GridCells& cells
                                                                     scores.data())));
             // The owner decides the side, then the seam gap moves the face inward.
             if (isInside) delta = isMember ? std::min(delta, -1e-6 * voxel) : std::max(delta, 1e-6 * voxel);
-            const double psi = std::max(double(field.phi[s]), delta + seamGapMm);
+            const double psi = std::max(double(phi[s]), delta + seamGapMm);
             if (psi >= bg) continue;
             isUsed = true;
             if (psi <= -bg)
@@ -283,7 +285,8 @@ PieceGrid pieceGrid(const VoxelField& field, const GridCells& cells, const std::
     openvdb::tools::dilateActiveValues(*mask, 1);
     addTenons(*out.grid, *mask, field, piece, options.tenons);
     addPins(*out.grid, *mask, field, piece, options.pins);
-    if (piece.label) engraveLabel(*out.grid, *mask, field, *piece.label, options.label);
+    if (piece.label)
+        engraveLabel(*out.grid, *mask, field, *piece.label, labelOptionsForWall(options.label, piece.wallMm));
     openvdb::tools::pruneLevelSet(out.grid->tree());
     if (!mask->empty()) {
         mask->voxelizeActiveTiles();  // the mesher looks the mask up by leaf nodes only

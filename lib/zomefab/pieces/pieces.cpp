@@ -21,6 +21,7 @@
 #include "zomefab/pieces/detail/grouping.h"
 #include "zomefab/pieces/detail/splits.h"
 #include "zomefab/pieces/detail/stages.h"
+#include "zomefab/pieces/detail/thin_wall.h"
 #include "zomefab/sdf/level_set_grid.h"
 
 namespace zomefab::pieces {
@@ -188,6 +189,9 @@ void checkPiecesOptions(const PiecesOptions& o) {
                     "the seam gap must be in [0, 2] mm, got " + formatNumber(o.seamGapMm, 4));
     if (!(o.adaptivity >= 0 && o.adaptivity <= 1))
         throw Error(ErrorCode::Usage, "adaptivity must be in [0, 1], got " + formatNumber(o.adaptivity, 4));
+    if (!(o.printWallMm == 0 || (o.printWallMm >= 1 && o.printWallMm <= 200)))
+        throw Error(ErrorCode::Usage, "--print-wall-mm must be 0 (the shell's wall) or in [1, 200] mm, got " +
+                                          formatNumber(o.printWallMm, 4));
     checkTenonOptions(o.tenons);
     checkLabelOptions(o.label);
 }
@@ -221,6 +225,10 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
 
     context.progress("pieces", 0.0);
     VoxelField field = buildField(*shell);
+    if (out.options.printWallMm > 0) {
+        checkPrintWall(out.options.printWallMm, fabrication.wallMm, field.background, voxel);
+        field.thinPhi = thinWallPhi(field, out.options.printWallMm);
+    }
     context.throwIfCancelled();
     const GridCells cells = toGridCells(partition.cells, frameToGridMm);
     labelCells(field, cells);

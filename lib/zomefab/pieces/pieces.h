@@ -92,6 +92,13 @@ struct PiecesOptions {
     /// piece's direction meets its wall within a tenon's reach (docs/mounting.md, "Frame grown
     /// toward a piece"). Only where makePieces is given a StrutTest (zomefab run).
     bool isGrowingFrame = true;
+    /// Print the pieces with this wall (mm) where it is thinner than the shell's; 0 = the shell's.
+    /// The plan (paths, order, pegs) is made with the shell's wall, the frame's forbidden zone;
+    /// a piece keeps only the outer printWallMm of it where each of its pegs grows again through
+    /// the thin wall (docs/pieces.md, "A thinner printed wall"), and stays thick otherwise: a
+    /// glued piece, one with alignment pins, or one whose stems cannot reach through. At most
+    /// the shell's band less half a voxel (2.5 mm at 1 mm voxels).
+    double printWallMm = 0.0;
 };
 
 /// Whether a strut from ball a through hole, of size, to a new ball at its end may be added to a
@@ -122,6 +129,10 @@ struct Piece {
 
     /// Pins and sockets toward the pieces it is glued to (the plan's glued pairs).
     std::vector<AlignmentPin> pins;
+
+    /// The wall it is printed with, mm: the shell's, or PiecesOptions::printWallMm (isThinWall).
+    double wallMm = 0.0;
+    bool isThinWall = false;
 
     std::optional<PieceLabel> label;  ///< the engraved number, when there was room
     std::string labelNote;            ///< why there is no label
@@ -170,6 +181,8 @@ struct Pieces {
     size_t printSplits = 0;
     /// Pairs glued before mounting because one of them was held by too few pegs (docs/mounting.md).
     size_t gluedForPegs = 0;
+    /// Pieces printed with PiecesOptions::printWallMm instead of the shell's wall.
+    size_t thinPieces = 0;
     /// The frame with the struts grown toward pieces too few pegs hold (PiecesOptions::
     /// isGrowingFrame): the frame to build and to write. Empty when none was grown.
     std::optional<zome::Structure> grownFrame;

@@ -67,6 +67,8 @@ void readOptions(const json& o, PiecesOptions& options) {
     const auto parsed = tenonHolesFromName(holes);
     if (!parsed) fail("tenons.holes must be lattice, blue or all, not \"" + holes + "\"");
     to.holes = *parsed;
+    options.printWallMm = optionalField(
+        o, "print_wall_mm", 0.0, [&](const json& v) { return numberFromJson(v, what + ".print_wall_mm"); });
 }
 
 Tenon tenonFromJson(const json& j, uint32_t piece, const std::string& what) {
@@ -143,6 +145,11 @@ Piece pieceFromJson(const json& j, size_t index, const std::string& directory) {
                              [&](const json& v) { return indexFromJson(v, what + ".piece"); });
     piece.volumeMm3 = optionalField(j, "volume_mm3", 0.0, number("volume_mm3"));
     piece.shellVolumeMm3 = optionalField(j, "shell_volume_mm3", 0.0, number("shell_volume_mm3"));
+    piece.wallMm = optionalField(j, "wall_mm", 0.0, number("wall_mm"));
+    piece.isThinWall = optionalField(j, "thin_wall", false, [&](const json& v) {
+        if (!v.is_boolean()) fail(what + ".thin_wall must be true or false");
+        return v.get<bool>();
+    });
     piece.gridBoundsMm = optionalField(j, "grid_bbox_mm", Box3d{},
                                        [&](const json& v) { return boxFromJson(v, what + ".grid_bbox_mm"); });
     readOrientation(j.value("orientation", json::object()), piece, what + ".orientation");

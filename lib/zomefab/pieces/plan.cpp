@@ -18,6 +18,7 @@
 #include "zomefab/pieces/detail/replan.h"
 #include "zomefab/pieces/detail/splits.h"
 #include "zomefab/pieces/detail/stages.h"
+#include "zomefab/pieces/detail/thin_wall.h"
 #include "zomefab/pieces/detail/tunnels.h"
 
 namespace zomefab::pieces::detail {
@@ -529,11 +530,7 @@ void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping
     };
     // The owner of the nearest voxel, band voxels included: a point the trilinear φ puts just
     // inside the wall may have its nearest voxel centre just outside.
-    probe.pieceAt = [&](const Vec3d& p) -> int64_t {
-        const size_t s = field.slotAt(p);
-        if (s == SIZE_MAX || field.owner[s] == kNone) return -1;
-        return int64_t(field.owner[s]);
-    };
+    probe.pieceAt = [&](const Vec3d& p) { return field.ownerNear(p); };
     if (opt.tenons.maxPerPiece > 0) {
         planMountingAndTenons(out, field, cells, grouping, probe, frame, frameToGridMm, fabrication, opt,
                               canGrow, context);
@@ -543,15 +540,30 @@ void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping
         out.plan.problems.push_back("no tenons (--max-tenons 0): nothing holds the pieces on the frame");
     }
     const size_t pieceCount = out.pieces.size();
+    for (Piece& piece : out.pieces) piece.wallMm = fabrication.wallMm, piece.isThinWall = false;
+    // The printed wall, where thinner than the plan's (thin_wall.h): after the plan, before numbers.
+    const ShellProbe thin = field.thinPhi.empty() ? probe : thinWallProbe(field, opt.printWallMm);
+    if (!field.thinPhi.empty() && opt.tenons.maxPerPiece > 0) {
+        out.thinPieces = thinPieces(out, field, frame, frameToGridMm, thin, fabrication.wallMm, opt.tenons);
+        context.info(std::to_string(out.thinPieces) + " of " + std::to_string(pieceCount) +
+                     " pieces printed with a " + formatNumber(opt.printWallMm) +
+                     " mm wall; the rest keep the " + formatNumber(fabrication.wallMm) +
+                     " mm of the shell (glued, or a peg that does not reach through the thin wall)");
+    }
     context.throwIfCancelled();
     if (!opt.label.isEnabled) return;
     const double reach = frame.scale().ballRadiusMm() + 3.0 * frame.scale().b0Mm;
     const auto spots = innerSurfaceSpots(frame, frameToGridMm, probe, pieceCount, reach);
+    const auto thinSpots = out.thinPieces > 0
+                               ? innerSurfaceSpots(frame, frameToGridMm, thin, pieceCount, reach)
+                               : std::vector<std::vector<SurfaceSpot>>();
     size_t unlabelled = 0;
     for (size_t p = 0; p < pieceCount; ++p) {
         Piece& piece = out.pieces[p];
-        piece.label = placeLabel(std::to_string(p), uint32_t(p), spots[p], piece.tenons, opt.tenons, probe,
-                                 opt.label, &piece.labelNote);
+        const bool isThin = piece.isThinWall;
+        piece.label = placeLabel(std::to_string(p), uint32_t(p), isThin ? thinSpots[p] : spots[p],
+                                 piece.tenons, opt.tenons, isThin ? thin : probe,
+                                 labelOptionsForWall(opt.label, piece.wallMm), &piece.labelNote);
         if (!piece.label) ++unlabelled;
     }
     if (unlabelled > 0)

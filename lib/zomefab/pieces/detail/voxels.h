@@ -92,6 +92,9 @@ struct VoxelField {
     /// per slot: the component of an inside voxel; after the pieces are known, the piece that owns
     /// the voxel (inside: its piece; band: that of the nearest inside voxel of its cell); kNone
     std::vector<uint32_t> owner;
+    /// per slot: φ of the thinner printed wall (PiecesOptions::printWallMm, thinWallPhi); empty
+    /// when the pieces are printed with the shell's wall.
+    std::vector<float> thinPhi;
 
     bool isInside(size_t slot) const { return isActive[slot] && phi[slot] < 0; }
     Coord coordOf(size_t slot) const {
@@ -119,6 +122,11 @@ struct VoxelField {
         Coord ijk;
         for (int a = 0; a < 3; ++a) ijk[a] = int(std::lround((p[size_t(a)] - originMm[size_t(a)]) / voxelMm));
         return slotOf(ijk);
+    }
+    /// The owner of the voxel nearest to @p p, band voxels included; −1 off the field or unowned.
+    int64_t ownerNear(const Vec3d& p) const {
+        const size_t s = slotAt(p);
+        return s == SIZE_MAX || owner[s] == kNone ? -1 : int64_t(owner[s]);
     }
 };
 

@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Pieces printed with a wall thinner than the shell's (lib/zomefab/pieces/thin_wall.cpp): on a
+// 200 mm spherical shell of 8 mm with a B0 cube lattice inside, the plan made with the 8 mm wall,
+// the pieces printed with 2.4 mm where their pegs reach through it.
+#include "zomefab/pieces/detail/thin_wall.h"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <set>
+
+#include "pieces_fixtures.h"
+#include "test_util.h"
+#include "zomefab/core/error.h"
+#include "zomefab/mesh/mesh_check.h"
+#include "zomefab/pieces/pieces.h"
+#include "zomefab/pieces/pieces_io.h"
+
+using namespace zomefab;
+using namespace zomefab::pieces;
+using namespace zomefab::pieces::test;
+
+namespace {
+
+constexpr double kThin = 2.4;
+
+constexpr double kRadius = kSphereRadiusMm, kShell = kSphereShellMm;
+
+const sdf::LevelSet& shell() { return sphereShell(); }
+const zome::Structure& frame() { return sphereFrame(); }
+
+Fabrication sphereFabrication() {
+    Fabrication f = printerOf({200, 200, 200});
+    f.wallMm = kShell;
+    return f;
+}
+
+Pieces cutSphere(double printWallMm) {
+    PiecesOptions o;
+    o.printWallMm = printWallMm;
+    return makePieces(shell(), frame(), Transform4d::identity(), quadrantCells(-15.3, 20.4),
+                      sphereFabrication(), o, RunContext::silent());
+}
+
+/// The distance from @p p to the nearest tenon axis of @p piece, from its peg's tip on.
+double distanceToStems(const Piece& piece, const Vec3d& p, const TenonOptions& o) {
+    double best = 1e300;
+    for (const Tenon& t : piece.tenons) {
+        const double along = dot(sub(p, t.ballCenterGridMm), t.axisGrid);
+        if (along < t.shoulderMm - o.pegDepthMm - 0.01) continue;
+        best = std::min(best, norm(sub(p, t.pointAt(along))));
+    }
+    return best;
+}
+
+}  // namespace
+
+TEST_CASE("thin wall: the plan of the shell's wall, each piece printed 2.4 mm thin where its pegs reach") {
+    const Pieces thick = cutSphere(0), thin = cutSphere(kThin);
+    REQUIRE(thick.pieces.size() == thin.pieces.size());
+    // The plan is the shell's: the same directions and steps.
+    CHECK(thin.plan.holeOfPiece == thick.plan.holeOfPiece);
+    REQUIRE(thin.plan.steps.size() == thick.plan.steps.size());
+    for (size_t s = 0; s < thin.plan.steps.size(); ++s)
+        CHECK(thin.plan.steps[s].pieces == thick.plan.steps[s].pieces);
+    CHECK(thick.thinPieces == 0);
+    CHECK(thin.thinPieces >= thin.pieces.size() / 2);
+    size_t counted = 0;
+    for (size_t i = 0; i < thin.pieces.size(); ++i) {
+        const Piece &p = thin.pieces[i], &q = thick.pieces[i];
+        INFO("piece " << i);
+        CHECK(q.wallMm == kShell);
+        CHECK(!q.isThinWall);
+        const mesh::MeshReport r = mesh::checkMesh(p.mesh);
+        CHECK(r.boundaryEdges == 0);
+        CHECK(r.nonManifoldEdges == 0);
+        CHECK(r.volume > 0);
+        if (!p.isThinWall) {
+            CHECK(p.wallMm == kShell);
+            continue;
+        }
+        counted += p.isThinWall ? 1 : 0;
+        CHECK(p.wallMm == kThin);
+        // The same pegs: every tenon on the same ball and hole, through the thin wall.
+        REQUIRE(p.tenons.size() == q.tenons.size());
+        std::set<std::pair<zome::BallId, int>> pegs;
+        for (const Tenon& t : q.tenons) pegs.insert({t.ball, t.hole});
+        for (const Tenon& t : p.tenons) {
+            CHECK(pegs.count({t.ball, t.hole}) == 1);
+            CHECK(t.baseMm > q.tenons.front().shoulderMm);
+        }
+        // A wall about 2.4/8 of the thick one's plastic, stems included.
+        CHECK(p.volumeMm3 < 0.55 * q.volumeMm3);
+        // Away from the stems the piece lies between the outer surface and 2.4 mm inside it, and
+        // nothing of it is outside the sphere.
+        const TriMesh m = gridMesh(p);
+        size_t wall = 0, off = 0;
+        for (const Vec3f& v : m.positions) {
+            const Vec3d x = toD(v);
+            const double radius = norm(x);
+            CHECK(radius <= kRadius + 0.3);
+            if (distanceToStems(p, x, thin.options.tenons) < 12.0 ||
+                (p.label && norm(sub(x, p.label->centerGridMm)) < 20.0))
+                continue;
+            ++wall;
+            off += radius < kRadius - kThin - 0.4 ? 1 : 0;
+        }
+        CHECK(wall > 100);
+        CHECK(off == 0);
+    }
+    CHECK(counted == thin.thinPieces);
+    // pieces.json keeps the printed wall.
+    const Pieces back = piecesFromJson(piecesToJson(thin, {"shell.vdb", "frame.json", "partition.json"}), "");
+    CHECK(back.options.printWallMm == kThin);
+    for (size_t i = 0; i < thin.pieces.size(); ++i) {
+        CHECK(back.pieces[i].wallMm == thin.pieces[i].wallMm);
+        CHECK(back.pieces[i].isThinWall == thin.pieces[i].isThinWall);
+    }
+}
+
+TEST_CASE("thin wall: a wall the shell's band or wall cannot give is refused, naming the option") {
+    CHECK_THROWS_WITH_AS(cutSphere(3.0),
+                         doctest::Contains("--print-wall-mm 3 is deeper than the shell's band"), Error);
+    CHECK_THROWS_WITH_AS(cutSphere(0.5), doctest::Contains("--print-wall-mm must be 0"), Error);
+    CHECK_THROWS_AS(detail::checkPrintWall(2.4, 6.0, 3.0, 1.0), Error);  // bands of a 6 mm wall touch
+    CHECK_NOTHROW(detail::checkPrintWall(2.4, 7.0, 3.0, 1.0));
+    CHECK_NOTHROW(detail::checkPrintWall(0.0, 4.0, 3.0, 1.0));  // off
+}
