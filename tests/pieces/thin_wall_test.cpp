@@ -79,7 +79,7 @@ TEST_CASE("thin wall: the plan of the shell's wall, each piece printed 2.4 mm th
             CHECK(p.wallMm == kShell);
             continue;
         }
-        counted += p.isThinWall ? 1 : 0;
+        ++counted;
         CHECK(p.wallMm == kThin);
         // The same pegs: every tenon on the same ball and hole, through the thin wall.
         REQUIRE(p.tenons.size() == q.tenons.size());

@@ -15,8 +15,6 @@ namespace zomefab::pieces::detail {
 
 namespace {
 
-constexpr int kFaceOffsets[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-
 /// δ of the cells' region of @p set and the half-spaces of its re-cuts (no seam gap).
 double pieceRegionDistance(const GridCells& cells, const CellSet& set, const Vec3d& x, double* scores) {
     double d = regionDistance(cells, set, x, scores);
@@ -227,18 +225,8 @@ std::vector<uint8_t> exteriorBand(const VoxelField& field) {
         if (z > top) top = z, start = s;
     }
     if (start == SIZE_MAX) return out;
-    std::vector<size_t> stack{start};
     out[start] = 1;
-    while (!stack.empty()) {
-        const Coord ijk = field.coordOf(stack.back());
-        stack.pop_back();
-        for (const auto& o : kFaceOffsets) {
-            const size_t t = field.slotOf(ijk.offsetBy(o[0], o[1], o[2]));
-            if (t == SIZE_MAX || out[t] || field.phi[t] < 0) continue;
-            out[t] = 1;
-            stack.push_back(t);
-        }
-    }
+    floodFaces(field, {start}, out, [&](size_t t) { return field.phi[t] >= 0; });
     return out;
 }
 

@@ -14,8 +14,6 @@ namespace zomefab::pieces::detail {
 
 namespace {
 
-constexpr int kFaceOffsets[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-
 /// A thin piece keeps at least this share of W / wall of its thick voxels: a wall W thick over the
 /// same outer surface has about that share; one with far fewer lies mostly away from the outer
 /// surface exteriorBand found (another component of the object), and stays thick.
@@ -28,19 +26,11 @@ std::vector<uint8_t> nearOuterSurface(const VoxelField& field) {
     std::vector<uint8_t> out(field.phi.size(), 0);
     const float deep = -field.background;
     // Flooded from the outside's band (not marked itself) through the band's wall voxels.
-    std::vector<size_t> stack;
+    std::vector<size_t> seeds;
     for (size_t s = 0; s < field.phi.size(); ++s)
-        if (field.isActive[s] && exterior[s]) stack.push_back(s);
-    while (!stack.empty()) {
-        const Coord ijk = field.coordOf(stack.back());
-        stack.pop_back();
-        for (const auto& o : kFaceOffsets) {
-            const size_t t = field.slotOf(ijk.offsetBy(o[0], o[1], o[2]));
-            if (t == SIZE_MAX || out[t] || !(field.phi[t] < 0 && field.phi[t] > deep)) continue;
-            out[t] = 1;
-            stack.push_back(t);
-        }
-    }
+        if (field.isActive[s] && exterior[s]) seeds.push_back(s);
+    floodFaces(field, std::move(seeds), out,
+               [&](size_t t) { return field.phi[t] < 0 && field.phi[t] > deep; });
     return out;
 }
 
@@ -70,7 +60,7 @@ bool crossesOtherPiece(const Tenon& t, const VoxelField& field, const TenonOptio
     for (double a = fromMm; a <= t.endMm; a += step)
         for (double fl : {-0.9, 0.0, 0.9})
             for (double fs : {-0.9, 0.0, 0.9}) {
-                const size_t s = field.slotAt(stemPointMm(t, o, std::min(a, t.endMm), fl, fs));
+                const size_t s = field.slotAt(stemPointMm(t, o, a, fl, fs));
                 if (s != SIZE_MAX && field.isInside(s) && field.owner[s] != t.piece) return true;
             }
     return false;
@@ -159,8 +149,6 @@ size_t thinPieces(Pieces& out, const VoxelField& field, const zome::Structure& f
     const std::vector<std::pair<size_t, size_t>> voxels = voxelCounts(field, out.pieces.size());
     size_t count = 0;
     for (Piece& piece : out.pieces) {
-        piece.wallMm = shellWallMm;
-        piece.isThinWall = false;
         if (isGlued[piece.id] || !piece.pins.empty() || piece.tenons.empty()) continue;
         std::vector<Tenon> tenons = thinTenons(piece, field, frame, frameToGridMm, thin, options);
         if (tenons.size() != piece.tenons.size()) continue;

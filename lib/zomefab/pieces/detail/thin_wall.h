@@ -9,7 +9,6 @@
 
 #include <vector>
 
-#include "zomefab/core/run_context.h"
 #include "zomefab/pieces/detail/voxels.h"
 #include "zomefab/pieces/pieces.h"
 #include "zomefab/pieces/tenons.h"
@@ -34,8 +33,9 @@ ShellProbe thinWallProbe(const VoxelField& field, double printWallMm);
 /// Each piece of @p out that can be printed thin: it is in no glued pair and carries no pin, each
 /// of its tenons (same ball and hole) is a candidate again through @p thin's wall that meets this
 /// piece, whose stem beyond the thick wall's inner surface crosses no other piece's wall, and the
-/// thin wall keeps a plausible share of its voxels. Such pieces get the new tenons, wallMm =
-/// printWallMm and isThinWall; the rest wallMm = @p shellWallMm. Returns how many are thin.
+/// thin wall keeps a plausible share (of @p shellWallMm's) of its voxels. Such pieces get the new
+/// tenons, wallMm = printWallMm and isThinWall; the rest are left as they are (the caller set them
+/// to the shell's wall). Returns how many are thin.
 size_t thinPieces(Pieces& out, const VoxelField& field, const zome::Structure& frame,
                   const Transform4d& frameToGridMm, const ShellProbe& thin, double shellWallMm,
                   const TenonOptions& options);

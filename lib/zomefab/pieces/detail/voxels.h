@@ -138,6 +138,28 @@ VoxelField buildField(const FloatGrid& shell);
 /// Sets every active slot's cell (argmax of @p cells, ties to the lowest). Parallel, deterministic.
 void labelCells(VoxelField& field, const GridCells& cells);
 
+/// The six face neighbours' index offsets.
+inline constexpr int kFaceOffsets[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                           {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+
+/// Marks in @p marked (one byte per slot) every slot 6-connected to the slots of @p stack through
+/// unmarked active slots that @p accept takes; the seeds themselves are marked only if the caller
+/// did. The set marked does not depend on the order of the seeds.
+template <class Accept>
+void floodFaces(const VoxelField& f, std::vector<size_t> stack, std::vector<uint8_t>& marked,
+                Accept&& accept) {
+    while (!stack.empty()) {
+        const Coord ijk = f.coordOf(stack.back());
+        stack.pop_back();
+        for (const auto& o : kFaceOffsets) {
+            const size_t t = f.slotOf(ijk.offsetBy(o[0], o[1], o[2]));
+            if (t == SIZE_MAX || marked[t] || !accept(t)) continue;
+            marked[t] = 1;
+            stack.push_back(t);
+        }
+    }
+}
+
 /// Calls @p visit(slot, neighbourSlot) for the +x, +y, +z neighbour of every active slot.
 template <class Visit>
 void forEachForwardPair(const VoxelField& f, Visit&& visit) {
