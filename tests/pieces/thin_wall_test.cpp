@@ -121,8 +121,30 @@ TEST_CASE("thin wall: the plan of the shell's wall, each piece printed 2.4 mm th
 TEST_CASE("thin wall: a wall the shell's band or wall cannot give is refused, naming the option") {
     CHECK_THROWS_WITH_AS(cutSphere(3.0),
                          doctest::Contains("--print-wall-mm 3 is deeper than the shell's band"), Error);
-    CHECK_THROWS_WITH_AS(cutSphere(0.5), doctest::Contains("--print-wall-mm must be 0"), Error);
+    CHECK_THROWS_WITH_AS(cutSphere(0.5), doctest::Contains("--print-wall-mm must be auto, 0"), Error);
+    CHECK_THROWS_WITH_AS(cutSphere(-2), doctest::Contains("--print-wall-mm must be auto, 0"), Error);
     CHECK_THROWS_AS(detail::checkPrintWall(2.4, 6.0, 3.0, 1.0), Error);  // bands of a 6 mm wall touch
     CHECK_NOTHROW(detail::checkPrintWall(2.4, 7.0, 3.0, 1.0));
     CHECK_NOTHROW(detail::checkPrintWall(0.0, 4.0, 3.0, 1.0));  // off
+}
+
+TEST_CASE("thin wall: by default 2.4 mm where the shell allows it, else the shell's wall") {
+    using detail::resolvePrintWallMm;
+    CHECK(PiecesOptions{}.printWallMm == kPrintWallAuto);
+    CHECK(resolvePrintWallMm(kPrintWallAuto, 16.0, 3.0, 1.0) == kDefaultPrintWallMm);
+    CHECK(resolvePrintWallMm(kPrintWallAuto, 7.0, 3.0, 1.0) == kDefaultPrintWallMm);
+    CHECK(resolvePrintWallMm(kPrintWallAuto, 6.0, 3.0, 1.0) == 0);   // a thin shell is printed as it is
+    CHECK(resolvePrintWallMm(kPrintWallAuto, 16.0, 1.5, 0.5) == 0);  // a 1.5 mm band cannot hold 2.4
+    CHECK(resolvePrintWallMm(kPrintWallAuto, 16.0, 2.91, 0.97) == kDefaultPrintWallMm);
+    CHECK(resolvePrintWallMm(0, 16.0, 3.0, 1.0) == 0);
+    CHECK(resolvePrintWallMm(2.0, 16.0, 3.0, 1.0) == 2.0);
+    CHECK_THROWS_AS(resolvePrintWallMm(2.4, 16.0, 1.5, 0.5), Error);  // asked for: refused, not ignored
+    // The sphere's 8 mm shell at 1 mm voxels: the default is the 2.4 mm run.
+    const Pieces byDefault = cutSphere(kPrintWallAuto), thin = cutSphere(kThin);
+    CHECK(byDefault.options.printWallMm == kThin);
+    CHECK(byDefault.thinPieces == thin.thinPieces);
+    CHECK(byDefault.thinPieces > 0);
+    REQUIRE(byDefault.pieces.size() == thin.pieces.size());
+    for (size_t i = 0; i < thin.pieces.size(); ++i)
+        CHECK(byDefault.pieces[i].volumeMm3 == doctest::Approx(thin.pieces[i].volumeMm3));
 }

@@ -242,13 +242,14 @@ TEST_CASE("long: the frame passes zf-zome check; every parts list equals the fra
         CHECK(guide.find(pieces::pieceName(d.result.pieces, i)) != std::string::npos);
 }
 
-TEST_CASE("long: pieces are closed, fit the printer, and sum to the shell's volume") {
+TEST_CASE("long: pieces are closed, fit the printer, and their parts sum to the shell's volume") {
     const DemoRun& d = demo();
     const json pj = json::parse(readInputBytes(d.file("pieces/pieces.json")));
     REQUIRE(pj["pieces"].size() == d.result.pieces.pieces.size());
     const bool hasAdmesh = test::hasCommand("admesh");
     if (!hasAdmesh) MESSAGE("admesh is not installed (apt-get install admesh): its check is skipped");
-    double volumeMm3 = 0;
+    double volumeMm3 = 0, shellShareMm3 = 0;
+    size_t thin = 0;
     for (const json& p : pj["pieces"]) {
         const std::string file = d.file("pieces/" + p["file"].get<std::string>());
         INFO(file);
@@ -258,6 +259,14 @@ TEST_CASE("long: pieces are closed, fit the printer, and sum to the shell's volu
         CHECK(m.inconsistentEdges == 0);
         CHECK(m.volume > 0);
         volumeMm3 += m.volume;
+        shellShareMm3 += p["shell_volume_mm3"].get<double>();
+        // Printed with the shell's wall, or (the default) 2.4 mm where its pegs reach through: about
+        // that share of its part of the shell, the stems through the hollow on top.
+        const double part = p["shell_volume_mm3"].get<double>();
+        const double share = p["wall_mm"].get<double>() / d.result.fabrication.wallMm;
+        thin += p["thin_wall"].get<bool>() ? 1 : 0;
+        CHECK(m.volume >= 0.9 * share * part);
+        CHECK(m.volume <= (p["thin_wall"].get<bool>() ? 0.5 : 1.05) * part);
         for (int a = 0; a < 3; ++a) {
             CHECK(m.bounds.min[size_t(a)] >= -1e-3);
             CHECK(m.bounds.max[size_t(a)] <= d.options.fabrication.printerMm[size_t(a)] + 1e-3);
@@ -278,8 +287,10 @@ TEST_CASE("long: pieces are closed, fit the printer, and sum to the shell's volu
                 CHECK(std::regex_search(a, std::regex(std::string(field) + R"(\s*:\s*0\s)")));
         }
     }
-    // Pieces are meshed from the voxels: within 1 % of the shell counted in voxels.
-    CHECK(volumeMm3 == doctest::Approx(d.result.pieces.shellVolumeMm3).epsilon(0.01));
+    // The pieces' parts are the shell, counted in voxels; most of the bunny's pieces are printed thin.
+    CHECK(shellShareMm3 == doctest::Approx(d.result.pieces.shellVolumeMm3).epsilon(0.01));
+    CHECK(thin == pj["summary"]["thin_pieces"].get<size_t>());
+    CHECK(2 * thin > pj["pieces"].size());
     CHECK(volumeMm3 == doctest::Approx(d.report["pieces"]["volume_mm3"].get<double>()).epsilon(1e-4));
     CHECK(d.report["cost"]["pieces_volume_mm3"].get<double>() == doctest::Approx(volumeMm3).epsilon(1e-4));
     CHECK(d.report["cost"]["pieces"] == pj["pieces"].size());

@@ -34,7 +34,7 @@ pipeline::RunOptions RunCli::resolve(uint64_t seed) const {
     o.field = field.options;
     o.frame = frame.options;
     o.partition = partition.resolve();
-    o.pieces = pieces.resolve();
+    o.pieces = pieces.resolve(fabrication.isWallGiven());
     o.cost = cost.resolve();
     o.preview = preview.resolve();
     pipeline::checkRunOptions(o);

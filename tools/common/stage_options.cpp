@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "stage_options.h"
 
+#include <cmath>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -86,10 +88,12 @@ void FabricationCli::addTo(CLI::App& app, unsigned parts) {
             ->capture_default_str();
     }
     if (parts & kWall)
-        app.add_option("--shell-mm", f.wallMm,
-                       "Shell wall thickness in mm (the paper: 16, its d_min; the frame keeps wall + "
-                       "--wall-gap-mm from the surface)")
-            ->capture_default_str();
+        wallOption =
+            app.add_option("--shell-mm", f.wallMm,
+                           "Shell wall thickness in mm: the plan's and the frame's (the paper: 16, its "
+                           "d_min; the frame keeps wall + --wall-gap-mm from the surface); given, it is "
+                           "also the printed wall unless --print-wall-mm says otherwise")
+                ->capture_default_str();
     if (parts & kFrameClearance) {
         app.add_option("--frame-clearance-mm", f.frameClearanceMm,
                        "Forbidden zone dMin: no ball or strut closer to the surface (mm)")
@@ -270,9 +274,10 @@ void PiecesCli::addTo(CLI::App& app) {
     app.add_flag("--no-glue-groups", isNotGluing,
                  "Do not glue a piece fewer than --min-tenons pegs hold to a neighbour before mounting, nor print "
                  "pieces glued together as one");
-    app.add_option("--print-wall-mm", o.printWallMm,
+    app.add_option("--print-wall-mm", printWall,
                    "Print each piece with this wall (mm) where its pegs reach through it; the plan and the "
-                   "frame keep --shell-mm (0 = print --shell-mm; at most 2.5 at 1 mm voxels)")
+                   "frame keep --shell-mm. auto: 2.4 where the shell allows it, the shell's wall when "
+                   "--shell-mm is given; 0 = print the shell's wall; at most 2.5 at 1 mm voxels")
         ->capture_default_str();
     app.add_flag("--no-label", isUnlabelled, "Do not engrave piece numbers");
     app.add_option("--label-height-mm", o.label.heightMm, "Height of the engraved digits")
@@ -280,8 +285,20 @@ void PiecesCli::addTo(CLI::App& app) {
     app.add_option("--label-depth-mm", o.label.depthMm, "Engraving depth")->capture_default_str();
 }
 
-pieces::PiecesOptions PiecesCli::resolve() const {
+pieces::PiecesOptions PiecesCli::resolve(bool isWallGiven) const {
     pieces::PiecesOptions o = options;
+    if (printWall == "auto") {
+        o.printWallMm = isWallGiven ? 0.0 : pieces::kPrintWallAuto;
+    } else {
+        char* end = nullptr;
+        o.printWallMm = std::strtod(printWall.c_str(), &end);
+        if (printWall.empty() || end != printWall.c_str() + printWall.size() ||
+            !std::isfinite(o.printWallMm) || o.printWallMm < 0)
+            throw Error(ErrorCode::Usage,
+                        "--print-wall-mm must be auto, 0 (the shell's wall) or in [1, 200] mm, "
+                        "not \"" +
+                            printWall + "\"");
+    }
     o.label.isEnabled = !isUnlabelled;
     o.isGluingUnderHeld = !isNotGluing;
     o.tenons.holes = *pieces::tenonHolesFromName(tenonHoles);

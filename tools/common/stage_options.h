@@ -49,8 +49,11 @@ enum FabricationPart : unsigned {
 struct FabricationCli {
     Fabrication fabrication;
     std::string printer;  ///< --printer-mm as given; empty = the default (or, for zf-pieces, the partition's)
+    CLI::Option* wallOption = nullptr;  ///< --shell-mm, where the tool has it
 
     void addTo(CLI::App& app, unsigned parts);
+    /// Whether --shell-mm was given (a wall the user chose is printed as it is).
+    bool isWallGiven() const { return wallOption && wallOption->count() > 0; }
     /// The Fabrication with --printer-mm parsed and @p seed (the tool's --seed) filled in.
     /// @throw Error(Usage) naming the option.
     Fabrication resolve(uint64_t seed) const;
@@ -89,10 +92,12 @@ struct PiecesCli {
     bool isUnlabelled = false;
     bool isNotGluing = false;  ///< --no-glue-groups
     std::string tenonHoles = "all";
+    std::string printWall = "auto";  ///< --print-wall-mm as given
 
     void addTo(CLI::App& app);
+    /// @p isWallGiven: the user chose the shell's wall (zomefab run --shell-mm), so "auto" prints it.
     /// @throw Error(Usage) for an option out of its range.
-    pieces::PiecesOptions resolve() const;
+    pieces::PiecesOptions resolve(bool isWallGiven = false) const;
 };
 
 struct CostCli {

@@ -64,6 +64,133 @@ void weldIdenticalVertices(TriMesh& mesh) {
     mesh.positions = std::move(welded);
 }
 
+namespace {
+
+uint64_t edgeKey(uint32_t from, uint32_t to) { return (uint64_t(from) << 32) | to; }
+
+Vec3d pointOf(const TriMesh& mesh, uint32_t v) {
+    const Vec3f& p = mesh.positions[v];
+    return {p[0], p[1], p[2]};
+}
+
+/// The corner of @p t opposite its longest edge: 0, 1 or 2.
+int cornerOppositeLongest(const TriMesh& mesh, const Triangle& t) {
+    int best = 0;
+    double longest = -1;
+    for (int k = 0; k < 3; ++k) {
+        const Vec3d e = sub(pointOf(mesh, t[size_t((k + 1) % 3)]), pointOf(mesh, t[size_t((k + 2) % 3)]));
+        if (dot(e, e) > longest) longest = dot(e, e), best = k;
+    }
+    return best;
+}
+
+}  // namespace
+
+bool isDegenerate(const TriMesh& mesh, const Triangle& t) {
+    if (hasRepeatedIndex(t)) return true;
+    const Vec3d a = pointOf(mesh, t[0]), b = pointOf(mesh, t[1]), c = pointOf(mesh, t[2]);
+    const double longest =
+        std::max({dot(sub(b, a), sub(b, a)), dot(sub(c, b), sub(c, b)), dot(sub(a, c), sub(a, c))});
+    return norm(cross(sub(b, a), sub(c, a))) <= 1e-9 * longest;
+}
+
+size_t collapseShortEdges(TriMesh& mesh, double maxEdge) {
+    DisjointSets merged(uint32_t(mesh.positions.size()));
+    bool isAny = false;
+    for (const Triangle& t : mesh.triangles)
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t a = t[size_t(k)], b = t[size_t((k + 1) % 3)];
+            const Vec3d e = sub(pointOf(mesh, a), pointOf(mesh, b));
+            if (a == b || dot(e, e) > maxEdge * maxEdge) continue;
+            merged.unite(a, b);
+            isAny = true;
+        }
+    if (!isAny) return 0;
+    for (Triangle& t : mesh.triangles)
+        for (uint32_t& v : t) v = merged.find(v);
+    // Keep the triangles that name three vertices and are not one of a face-to-face pair.
+    std::unordered_map<uint64_t, std::vector<uint32_t>> bySet;  // lowest two corners -> triangles
+    std::vector<uint8_t> isKept(mesh.triangles.size(), 0);
+    for (uint32_t i = 0; i < mesh.triangles.size(); ++i) {
+        if (hasRepeatedIndex(mesh.triangles[i])) continue;
+        isKept[i] = 1;
+        Triangle s = mesh.triangles[i];
+        std::sort(s.begin(), s.end());
+        bySet[edgeKey(s[0], s[1])].push_back(i);
+    }
+    auto sorted = [&](uint32_t i) {
+        Triangle s = mesh.triangles[i];
+        std::sort(s.begin(), s.end());
+        return s;
+    };
+    for (auto& [key, list] : bySet)
+        for (size_t x = 0; x < list.size(); ++x)
+            for (size_t y = x + 1; y < list.size(); ++y) {
+                const uint32_t i = list[x], j = list[y];
+                if (!isKept[i] || !isKept[j] || sorted(i) != sorted(j)) continue;
+                isKept[i] = isKept[j] = 0;  // same corners: as two faces of a closed mesh, opposite
+            }
+    const size_t before = mesh.triangles.size();
+    size_t out = 0;
+    for (size_t i = 0; i < before; ++i)
+        if (isKept[i]) {
+            if (!mesh.salientFaces.empty()) mesh.salientFaces[out] = mesh.salientFaces[i];
+            mesh.triangles[out++] = mesh.triangles[i];
+        }
+    mesh.triangles.resize(out);
+    if (!mesh.salientFaces.empty()) mesh.salientFaces.resize(out);
+    return before - out;
+}
+
+size_t flipNeedles(TriMesh& mesh) {
+    std::vector<uint32_t> needles;
+    for (uint32_t i = 0; i < mesh.triangles.size(); ++i)
+        if (!hasRepeatedIndex(mesh.triangles[i]) && isDegenerate(mesh, mesh.triangles[i]))
+            needles.push_back(i);
+    if (needles.empty()) return 0;
+    // Directed edge -> its triangle; UINT32_MAX where an edge is used twice the same way.
+    std::unordered_map<uint64_t, uint32_t> owner;
+    owner.reserve(3 * mesh.triangles.size());
+    auto setEdges = [&](uint32_t i, bool isAdding) {
+        const Triangle& t = mesh.triangles[i];
+        for (int k = 0; k < 3; ++k) {
+            const uint64_t key = edgeKey(t[size_t(k)], t[size_t((k + 1) % 3)]);
+            if (!isAdding) {
+                owner.erase(key);
+                continue;
+            }
+            auto [it, inserted] = owner.emplace(key, i);
+            if (!inserted) it->second = UINT32_MAX;
+        }
+    };
+    for (uint32_t i = 0; i < mesh.triangles.size(); ++i) setEdges(i, true);
+    size_t flipped = 0;
+    for (const uint32_t i : needles) {
+        const Triangle t = mesh.triangles[i];
+        if (!isDegenerate(mesh, t)) continue;  // an earlier flip mended it
+        const int k = cornerOppositeLongest(mesh, t);
+        const uint32_t c = t[size_t(k)], a = t[size_t((k + 1) % 3)], b = t[size_t((k + 2) % 3)];
+        const auto across = owner.find(edgeKey(b, a));
+        if (across == owner.end() || across->second == UINT32_MAX) continue;
+        const uint32_t n = across->second;
+        const Triangle m = mesh.triangles[n];
+        uint32_t d = m[0];
+        for (uint32_t v : m)
+            if (v != a && v != b) d = v;
+        if (d == c || owner.count(edgeKey(c, d)) || owner.count(edgeKey(d, c))) continue;
+        const Triangle first{a, d, c}, second{d, b, c};
+        if (isDegenerate(mesh, first) || isDegenerate(mesh, second)) continue;
+        setEdges(i, false);
+        setEdges(n, false);
+        mesh.triangles[i] = first;
+        mesh.triangles[n] = second;
+        setEdges(i, true);
+        setEdges(n, true);
+        ++flipped;
+    }
+    return flipped;
+}
+
 double signedVolume(const TriMesh& mesh, const std::vector<uint32_t>& triangles, const Vec3d& origin) {
     double sum = 0;
     for (uint32_t t : triangles) {

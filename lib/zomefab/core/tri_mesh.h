@@ -50,6 +50,24 @@ void appendMesh(TriMesh& mesh, const TriMesh& other);
 /// renumbers the triangles. Triangles are kept as they are, including any that now repeat a vertex.
 void weldIdenticalVertices(TriMesh& mesh);
 
+/// Whether the triangle's corners are collinear to rounding: twice its area at most 1e-9 × its
+/// longest edge squared (mesh::checkMesh's "degenerate"), or a vertex named twice.
+bool isDegenerate(const TriMesh& mesh, const Triangle& t);
+
+/// Merges the two ends of every edge no longer than @p maxEdge into one vertex (points a few
+/// float roundings apart, as the adaptive mesher can leave; such a sliver's facet normal is noise in
+/// float, and slicers and admesh "fix" it), then drops the triangles that now name a vertex twice
+/// and the pairs that now cover each other face to face. What is left of a closed mesh stays
+/// closed. Returns how many triangles were dropped.
+size_t collapseShortEdges(TriMesh& mesh, double maxEdge);
+
+/// Removes needles from a closed mesh: a degenerate triangle (a, b, c) whose corner c lies on its
+/// longest edge ab is flipped with its neighbour (b, a, d) across that edge into (a, d, c) and
+/// (d, b, c), which cover the same surface. Where the new edge cd already exists, or the neighbour
+/// is missing or shared by more than two triangles, the needle is left. Returns how many were
+/// flipped away.
+size_t flipNeedles(TriMesh& mesh);
+
 /// Signed volume of the closed, oriented surface made of @p triangles (divergence theorem), each
 /// corner taken relative to @p origin so that the sum stays well conditioned far from the
 /// coordinate origin. Cubed mesh units (mm³ after scaling); > 0 for an outward surface.

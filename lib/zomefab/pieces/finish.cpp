@@ -110,6 +110,11 @@ std::string finishPiece(Piece& piece, TriMesh mesh, const GridCells& cells, cons
     weldIdenticalVertices(mesh);
     mesh.triangles.erase(std::remove_if(mesh.triangles.begin(), mesh.triangles.end(), hasRepeatedIndex),
                          mesh.triangles.end());
+    // It can also emit points a few float roundings apart that are not identical, and three points
+    // in a row (both seen where a stem meets a thin wall): short edges are collapsed (0.1 µm, far
+    // below a printer's resolution), needles flipped.
+    collapseShortEdges(mesh, 1e-4);
+    flipNeedles(mesh);
     piece.mesh = std::move(mesh);
     return orientation.note;
 }

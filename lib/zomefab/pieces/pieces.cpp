@@ -189,9 +189,11 @@ void checkPiecesOptions(const PiecesOptions& o) {
                     "the seam gap must be in [0, 2] mm, got " + formatNumber(o.seamGapMm, 4));
     if (!(o.adaptivity >= 0 && o.adaptivity <= 1))
         throw Error(ErrorCode::Usage, "adaptivity must be in [0, 1], got " + formatNumber(o.adaptivity, 4));
-    if (!(o.printWallMm == 0 || (o.printWallMm >= 1 && o.printWallMm <= 200)))
-        throw Error(ErrorCode::Usage, "--print-wall-mm must be 0 (the shell's wall) or in [1, 200] mm, got " +
-                                          formatNumber(o.printWallMm, 4));
+    if (!(o.printWallMm == kPrintWallAuto || o.printWallMm == 0 ||
+          (o.printWallMm >= 1 && o.printWallMm <= 200)))
+        throw Error(ErrorCode::Usage,
+                    "--print-wall-mm must be auto, 0 (the shell's wall) or in [1, 200] mm, got " +
+                        formatNumber(o.printWallMm, 4));
     checkTenonOptions(o.tenons);
     checkLabelOptions(o.label);
 }
@@ -225,10 +227,16 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
 
     context.progress("pieces", 0.0);
     VoxelField field = buildField(*shell);
-    if (out.options.printWallMm > 0) {
-        checkPrintWall(out.options.printWallMm, fabrication.wallMm, field.background, voxel);
+    out.options.printWallMm =
+        resolvePrintWallMm(options.printWallMm, fabrication.wallMm, field.background, voxel);
+    if (out.options.printWallMm > 0)
         field.thinPhi = thinWallPhi(field, out.options.printWallMm);
-    }
+    else if (options.printWallMm == kPrintWallAuto && fabrication.wallMm > 2 * kDefaultPrintWallMm)
+        context.info("pieces printed with the shell's " + formatNumber(fabrication.wallMm) +
+                     " mm wall: a printed wall of " + formatNumber(kDefaultPrintWallMm) +
+                     " mm needs a shell of at least " + formatNumber(2 * field.background + voxel) +
+                     " mm and voxels of at least " +
+                     formatNumber(kDefaultPrintWallMm / (field.background / voxel - 0.5), 3) + " mm");
     context.throwIfCancelled();
     const GridCells cells = toGridCells(partition.cells, frameToGridMm);
     labelCells(field, cells);

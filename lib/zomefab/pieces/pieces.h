@@ -58,6 +58,14 @@ struct PinOptions {
     int perPair = 2;            ///< pins per glued pair, as far apart as the face allows
 };
 
+/// PiecesOptions::printWallMm's "choose for me": kDefaultPrintWallMm where the shell allows it.
+constexpr double kPrintWallAuto = -1.0;
+/// The printed wall chosen for a 0.4 mm nozzle and printed PLA: about five extrusion lines, the
+/// thinnest wall whose bending under a hand's press between two pegs stays a few millimetres at
+/// the flat bound and whose stress stays under half of what PLA takes across layers (docs/pieces.md,
+/// "Wall thickness"). Within the shell's band at voxels of at least 0.96 mm.
+constexpr double kDefaultPrintWallMm = 2.4;
+
 struct PiecesOptions {
     /// Connected pieces with less volume are merged into the neighbour they share the largest cut
     /// face with (a 2 cm³ sliver is too small to carry a tenon or to print well). Never dropped:
@@ -97,8 +105,10 @@ struct PiecesOptions {
     /// a piece keeps only the outer printWallMm of it where each of its pegs grows again through
     /// the thin wall (docs/pieces.md, "A thinner printed wall"), and stays thick otherwise: a
     /// glued piece, one with alignment pins, or one whose stems cannot reach through. At most
-    /// the shell's band less half a voxel (2.5 mm at 1 mm voxels).
-    double printWallMm = 0.0;
+    /// the shell's band less half a voxel (2.5 mm at 1 mm voxels). kPrintWallAuto (the default):
+    /// kDefaultPrintWallMm where the shell allows it (a wall of two bands and a voxel, voxels
+    /// of at least 0.96 mm), else the shell's wall.
+    double printWallMm = kPrintWallAuto;
 };
 
 /// Whether a strut from ball a through hole, of size, to a new ball at its end may be added to a

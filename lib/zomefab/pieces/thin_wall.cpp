@@ -114,6 +114,19 @@ void checkPrintWall(double printWallMm, double shellWallMm, double backgroundMm,
                                           formatNumber(shellWallMm) + " mm)");
 }
 
+double resolvePrintWallMm(double requested, double shellWallMm, double backgroundMm, double voxelMm) {
+    if (requested != kPrintWallAuto) {
+        checkPrintWall(requested, shellWallMm, backgroundMm, voxelMm);
+        return requested;
+    }
+    try {
+        checkPrintWall(kDefaultPrintWallMm, shellWallMm, backgroundMm, voxelMm);
+        return kDefaultPrintWallMm;
+    } catch (const Error&) {
+        return 0.0;  // a thin shell, or a band too narrow: the shell's wall is printed as it is
+    }
+}
+
 std::vector<float> thinWallPhi(const VoxelField& field, double printWallMm) {
     const std::vector<uint8_t> isNearOuter = nearOuterSurface(field);
     const float wall = float(printWallMm), bg = field.background;

@@ -21,6 +21,11 @@ namespace zomefab::pieces::detail {
 /// (half a voxel to spare), and the shell's two bands must be apart (wall ≥ 2 bands + a voxel).
 void checkPrintWall(double printWallMm, double shellWallMm, double backgroundMm, double voxelMm);
 
+/// The printed wall makePieces uses for PiecesOptions::printWallMm = @p requested: kPrintWallAuto
+/// gives kDefaultPrintWallMm where checkPrintWall passes it, else 0 (the shell's wall); any other
+/// value is checked (checkPrintWall throws) and returned.
+double resolvePrintWallMm(double requested, double shellWallMm, double backgroundMm, double voxelMm);
+
 /// Per slot of @p field: φ of the thin wall, max(φ, −φ − W) near the outer surface (wall voxels
 /// 6-connected through the band to exteriorBand), positive (background − W) deeper in the wall
 /// and in the hollow's band, φ outside the material. W = @p printWallMm < field.background.
