@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <map>
 #include <unordered_map>
 
 #include "zomefab/core/disjoint_sets.h"
@@ -108,28 +109,19 @@ size_t collapseShortEdges(TriMesh& mesh, double maxEdge) {
     if (!isAny) return 0;
     for (Triangle& t : mesh.triangles)
         for (uint32_t& v : t) v = merged.find(v);
-    // Keep the triangles that name three vertices and are not one of a face-to-face pair.
-    std::unordered_map<uint64_t, std::vector<uint32_t>> bySet;  // lowest two corners -> triangles
+    // Keep the triangles that name three vertices and are not one of a face-to-face pair (the same
+    // corners: as two faces of a closed mesh, opposite).
+    std::map<Triangle, std::vector<uint32_t>> byCorners;
     std::vector<uint8_t> isKept(mesh.triangles.size(), 0);
     for (uint32_t i = 0; i < mesh.triangles.size(); ++i) {
         if (hasRepeatedIndex(mesh.triangles[i])) continue;
         isKept[i] = 1;
         Triangle s = mesh.triangles[i];
         std::sort(s.begin(), s.end());
-        bySet[edgeKey(s[0], s[1])].push_back(i);
+        byCorners[s].push_back(i);
     }
-    auto sorted = [&](uint32_t i) {
-        Triangle s = mesh.triangles[i];
-        std::sort(s.begin(), s.end());
-        return s;
-    };
-    for (auto& [key, list] : bySet)
-        for (size_t x = 0; x < list.size(); ++x)
-            for (size_t y = x + 1; y < list.size(); ++y) {
-                const uint32_t i = list[x], j = list[y];
-                if (!isKept[i] || !isKept[j] || sorted(i) != sorted(j)) continue;
-                isKept[i] = isKept[j] = 0;  // same corners: as two faces of a closed mesh, opposite
-            }
+    for (const auto& [corners, list] : byCorners)
+        for (size_t x = 0; x + 1 < list.size(); x += 2) isKept[list[x]] = isKept[list[x + 1]] = 0;
     const size_t before = mesh.triangles.size();
     size_t out = 0;
     for (size_t i = 0; i < before; ++i)

@@ -211,11 +211,8 @@ MeshReport checkMesh(const TriMesh& mesh) {
         for (uint32_t v : t) used[v] = 1;
         const Vec3d a = toD(mesh.positions[t[0]]), b = toD(mesh.positions[t[1]]),
                     c = toD(mesh.positions[t[2]]);
-        const double twiceArea = norm(cross(sub(b, a), sub(c, a)));
-        r.area += 0.5 * twiceArea;
-        const double longest =
-            std::max({dot(sub(b, a), sub(b, a)), dot(sub(c, b), sub(c, b)), dot(sub(a, c), sub(a, c))});
-        if (hasRepeatedIndex(t) || twiceArea <= 1e-9 * longest) ++r.degenerateTriangles;
+        r.area += 0.5 * norm(cross(sub(b, a), sub(c, a)));
+        if (isDegenerate(mesh, t)) ++r.degenerateTriangles;
         std::array<uint32_t, 3> s = t;
         std::sort(s.begin(), s.end());
         sortedTriangles.push_back(s);
