@@ -857,3 +857,79 @@ TEST_CASE("zip: stored entries when deflate does not help") {
     CHECK(entries.at("b.txt") == std::string(1000, 'a'));
     CHECK(readU16(zip, 8) == 0);  // the 1-byte entry is stored
 }
+
+namespace {
+
+/// A spherical cap shell: radius @p radiusMm (outer), wall @p wallMm, polar angle up to @p capDeg
+/// about +z, closed by its rim band; outward facets.
+TriMesh capShell(double radiusMm, double wallMm, double capDeg, int rings = 24, int segments = 72) {
+    TriMesh m;
+    const double cap = capDeg * std::acos(-1.0) / 180.0;
+    auto point = [&](double r, int ring, int segment) {
+        const double polar = cap * ring / rings, azimuth = 2.0 * std::acos(-1.0) * segment / segments;
+        return Vec3f{float(r * std::sin(polar) * std::cos(azimuth)),
+                     float(r * std::sin(polar) * std::sin(azimuth)), float(r * std::cos(polar))};
+    };
+    // Vertex (side, ring, segment); ring 0 is the pole (one vertex per side).
+    auto index = [&](int side, int ring, int segment) {
+        return uint32_t(side * (1 + rings * segments) +
+                        (ring == 0 ? 0 : 1 + (ring - 1) * segments + segment % segments));
+    };
+    for (int side = 0; side < 2; ++side) {
+        const double r = side == 0 ? radiusMm : radiusMm - wallMm;
+        m.positions.push_back(point(r, 0, 0));
+        for (int ring = 1; ring <= rings; ++ring)
+            for (int segment = 0; segment < segments; ++segment)
+                m.positions.push_back(point(r, ring, segment));
+    }
+    for (int side = 0; side < 2; ++side)
+        for (int ring = 0; ring < rings; ++ring)
+            for (int s = 0; s < segments; ++s) {
+                const uint32_t a = index(side, ring, s), b = index(side, ring, s + 1),
+                               c = index(side, ring + 1, s), d = index(side, ring + 1, s + 1);
+                // Outer side faces away from the centre, inner side towards it.
+                auto add = [&](uint32_t x, uint32_t y, uint32_t z) {
+                    m.triangles.push_back(side == 0 ? Triangle{x, y, z} : Triangle{x, z, y});
+                };
+                if (ring > 0) add(a, c, b);
+                add(b, c, d);
+            }
+    for (int s = 0; s < segments; ++s) {  // the rim: outer ring to inner ring
+        const uint32_t a = index(0, rings, s), b = index(0, rings, s + 1), c = index(1, rings, s),
+                       d = index(1, rings, s + 1);
+        m.triangles.push_back({a, b, c});
+        m.triangles.push_back({b, d, c});
+    }
+    return m;
+}
+
+}  // namespace
+
+TEST_CASE("orientation: print time counts: a thin cap is turned to print faster than for support alone") {
+    // A cap of a 100 mm sphere, 60° about its pole, 2.4 mm thick (the thin printed wall). Scored
+    // by support alone (every PrintTimeModel rate 0) it rests on 145 mm² of its rim, "down" 56°
+    // from its axis, much of its wall shallow enough to print as solid layers; with the time model
+    // it is turned further (76°, on its supports), its wall steeper and more of it perimeters
+    // (PrusaSlicer prints a 2.4 mm plate at 60° in half the time it takes lying flat).
+    const TriMesh cap = capShell(100.0, 2.4, 60.0);
+    REQUIRE(signedVolume(cap) > 0.0);
+    const double pi = std::acos(-1.0);
+    const double volume =
+        2.0 * pi / 3.0 * (1.0 - std::cos(pi / 3.0)) * (std::pow(100.0, 3) - std::pow(97.6, 3));
+    CHECK(signedVolume(cap) == doctest::Approx(volume).epsilon(0.02));
+    PrintTimeModel untimed;
+    untimed.perimeterSPerMm3 = untimed.solidSPerMm3 = untimed.interiorSPerMm3 = 0.0;
+    const PrintOrientation bySupport =
+        orientForPrinter(cap, {}, {200, 200, 200}, kFlatToleranceMm, kOverhangDeg, untimed);
+    const PrintOrientation o = orientForPrinter(cap, {}, {200, 200, 200});
+    INFO(o.note);
+    CHECK(o.fits);
+    const double timed = skinSeconds(cap, scale(o.downNormal, -1.0));
+    const double untimedSeconds = skinSeconds(cap, scale(bySupport.downNormal, -1.0));
+    CHECK(timed < 0.95 * untimedSeconds);
+    // Not at the price of more support here.
+    CHECK(o.support.volumeMm3 < bySupport.support.volumeMm3);
+    // Lying on either face takes longer still.
+    for (const Vec3d& lying : {Vec3d{0, 0, -1}, Vec3d{0, 0, 1}})
+        CHECK(timed < skinSeconds(cap, scale(lying, -1.0)));
+}

@@ -501,24 +501,29 @@ TEST_CASE("long: the estimator agrees with PrusaSlicer within 15 % on the pieces
         std::string what;
         const std::vector<const TriMesh*> parts;
         double infillPercent;
+        bool supports;
     };
     auto every = [](size_t step, auto&& meshes) {
         std::vector<const TriMesh*> out;
         for (size_t i = 0; i < meshes.size(); i += step) out.push_back(&meshes[i]);
         return out;
     };
-    // Sliced without supports: a piece that stands on its supports has no first layer without
-    // them (PrusaSlicer: "no extrusions in the first layer"), so it is left out.
+    // The pieces as they are printed, with automatic supports where they overhang (some stand on
+    // their supports and have no first layer without them); the baseline's parts lie on a cut face.
+    // Without supports the estimator was 21 % slow on the pieces: they are turned so their thin walls
+    // print steep, where its perimeter rate, fitted over thick parts, is too slow (docs/benchmarks.md,
+    // "Pieces turned for print time"). With them, as printed, all 13 of the demo's pieces: 138.9 h
+    // estimated against 140.8 h sliced.
     std::vector<TriMesh> printed;
-    for (const pieces::Piece& p : d.result.pieces.pieces)
-        if (!p.isOnSupports) printed.push_back(p.mesh);
-    const Sample samples[] = {{"pieces", every(2, printed), cost.hollowInfillPercent},
-                              {"baseline", every(3, baseline), cost.hollowInfillPercent},
-                              {"pieces", every(4, printed), cost.solidInfillPercent},
-                              {"baseline", every(6, baseline), cost.solidInfillPercent}};
+    for (const pieces::Piece& p : d.result.pieces.pieces) printed.push_back(p.mesh);
+    const Sample samples[] = {{"pieces", every(2, printed), cost.hollowInfillPercent, true},
+                              {"baseline", every(3, baseline), cost.hollowInfillPercent, false},
+                              {"pieces", every(4, printed), cost.solidInfillPercent, true},
+                              {"baseline", every(6, baseline), cost.solidInfillPercent, false}};
     for (const Sample& sample : samples) {
         report::PrintSettings settings = cost.print;
         settings.infillPercent = sample.infillPercent;
+        settings.supports = sample.supports;
         report::PrintEstimate estimated, sliced;
         for (size_t i = 0; i < sample.parts.size(); ++i) {
             estimated += report::estimatePrint(*sample.parts[i], settings, cost.rates);

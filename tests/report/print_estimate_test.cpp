@@ -59,6 +59,35 @@ TEST_CASE("print_estimate: the breakdown of a 20 mm cube follows the documented 
                                        e.infillMm3 * r.sparseInfillSPerMm3));
 }
 
+TEST_CASE("print_estimate: the pieces' orientation weighs time with the estimator's defaults") {
+    // pieces::PrintTimeModel{} is what orientForPrinter uses; it must be the estimator's model at
+    // the default settings (20 % infill), or the pieces would be turned for another printer.
+    const pieces::PrintTimeModel mine = printTimeModel(PrintSettings{});
+    const pieces::PrintTimeModel theirs;
+    CHECK(theirs.skin.perimeterMm == doctest::Approx(mine.skin.perimeterMm).epsilon(1e-4));
+    CHECK(theirs.skin.topMm == doctest::Approx(mine.skin.topMm));
+    CHECK(theirs.skin.bottomMm == doctest::Approx(mine.skin.bottomMm));
+    CHECK(theirs.skin.marginMm == doctest::Approx(mine.skin.marginMm));
+    CHECK(theirs.skin.maxSlopeTan == doctest::Approx(mine.skin.maxSlopeTan).epsilon(1e-4));
+    // Perimeters: PrusaSlicer's rate in a thin wall, below the estimator's fit over thick parts.
+    CHECK(theirs.perimeterSPerMm3 < mine.perimeterSPerMm3);
+    CHECK(theirs.solidSPerMm3 == doctest::Approx(mine.solidSPerMm3));
+    CHECK(theirs.interiorSPerMm3 == doctest::Approx(mine.interiorSPerMm3));
+    CHECK(theirs.supportSPerColumnMm3 == doctest::Approx(mine.supportSPerColumnMm3));
+    // The same model: skinSeconds is estimatePrint's time without supports.
+    const TriMesh sphere = makeSphere({0, 0, 30}, 30);
+    CHECK(pieces::skinSeconds(sphere, {0, 0, 1}, mine) ==
+          doctest::Approx(estimatePrint(sphere, PrintSettings{}).seconds));
+    // A 2.4 mm plate prints faster standing than lying (PrusaSlicer: 1.9 h against 3.2 h for
+    // 100 × 100 mm): perimeters rather than slow solid layers.
+    const TriMesh plate = makeBox({0, 0, 0}, {100, 100, 2.4});
+    const double lying = pieces::skinSeconds(plate, {0, 0, 1}),
+                 standing = pieces::skinSeconds(plate, {1, 0, 0});
+    CHECK(lying > 1.15 * standing);
+    CHECK(lying / 3600.0 == doctest::Approx(3.2).epsilon(0.15));
+    CHECK(standing / 3600.0 == doctest::Approx(1.9).epsilon(0.15));
+}
+
 TEST_CASE("print_estimate: solid parts use all their volume; thin walls are all shell") {
     const TriMesh cube = makeBox({0, 0, 0}, {50, 50, 50});
     const PrintEstimate solid = estimatePrint(cube, withInfill(100));

@@ -161,9 +161,13 @@ constexpr double kOnSupportsPenaltyMm3 = 50000.0;
 /// near the bed would stand on nothing the slicer prints ("no extrusions in the first layer").
 constexpr double kMinHoldMm2 = 400.0;
 
-/// Between orientations needing the same support, the larger first layer wins (a bar lies on its
-/// side, not on its end).
-constexpr double kBaseTieBreakMm3PerMm2 = 0.01;
+/// What a mm² of first layer is worth in the orientation score, in mm³ of support columns: about
+/// half a second of print (PrintTimeModel's 0.116 s per mm³ of columns). A larger first layer
+/// holds a part better, so between orientations whose times differ by less than that the larger
+/// first layer wins: a solid bar lies on its side, although standing its long sides would be
+/// perimeters (2–4 % faster), while a thin wall, twice as fast standing as lying, is turned up
+/// onto its rim (its first layer is small either way).
+constexpr double kBaseTieBreakMm3PerMm2 = 4.3;
 
 /// A cut face on the bed is kept unless resting elsewhere saves more than this share of its
 /// support and this volume: a flat first layer is worth a little support.
@@ -174,8 +178,13 @@ constexpr double kCutFaceSupportSlackMm3 = 2000.0;
 class OrientationSearch {
 public:
     OrientationSearch(const TriMesh& meshMm, const std::vector<CutFace>& cutFaces, const Vec3d& printer,
-                      double flatToleranceMm, double overhangDeg)
-        : mesh(meshMm, overhangDeg), cutFaces(cutFaces), printer(printer), flatToleranceMm(flatToleranceMm) {
+                      double flatToleranceMm, double overhangDeg, const PrintTimeModel& time)
+        : mesh(meshMm, overhangDeg),
+          volumeMm3(std::max(0.0, signedVolume(meshMm))),
+          time(time),
+          cutFaces(cutFaces),
+          printer(printer),
+          flatToleranceMm(flatToleranceMm) {
         for (const CutFace& f : cutFaces) directions.push_back(f.outwardNormal);
         for (const Vec3d& d : facetDirections(mesh)) directions.push_back(d);
         searchStart = directions.size();
@@ -185,9 +194,17 @@ public:
     bool fits(const Vec3d& d) const { return fitsOnBed(mesh.points, d, printer); }
     double firstLayerMm2(const Vec3d& d) const { return sectionArea(mesh, d, kBaseHeightMm); }
     bool hasFirstLayer(const Vec3d& d) const { return firstLayerMm2(d) >= kMinBaseMm2; }
-    /// Support volume plus what a first layer of @p baseMm2 costs below a brim's worth
-    /// (kContactPenaltyMm3PerMm2), less a tie-break for the larger base.
-    double score(const Vec3d& d, double baseMm2) const { return score(supportColumnsMm3(mesh, d), baseMm2); }
+    /// The time the piece's perimeters, solid layers and infill take with @p d down, in mm³ of
+    /// support columns that take as long (PrintTimeModel): a thin wall standing prints in about
+    /// half the time it takes lying flat, which is worth more than a little support.
+    double skinScore(const Vec3d& d) const {
+        return skinSeconds(mesh, scale(d, -1.0), time, volumeMm3) / time.supportSPerColumnMm3;
+    }
+    /// Support volume and skinScore plus what a first layer of @p baseMm2 costs below a brim's
+    /// worth (kContactPenaltyMm3PerMm2), less a tie-break for the larger base.
+    double score(const Vec3d& d, double baseMm2) const {
+        return score(supportColumnsMm3(mesh, d) + skinScore(d), baseMm2);
+    }
     static double score(double supportMm3, double baseMm2) {
         return supportMm3 + kContactPenaltyMm3PerMm2 * std::max(0.0, kBrimBelowMm2 - baseMm2) -
                kBaseTieBreakMm3PerMm2 * baseMm2;
@@ -228,7 +245,8 @@ public:
                 byScore.push_back({score(directions[i], base), i});
             else if (const SupportColumns c = supportColumns(mesh, directions[i]);
                      base + c.bedMm2 >= kMinHoldMm2)
-                onSupports.push_back({score(c.volumeMm3, base) + kOnSupportsPenaltyMm3, i});
+                onSupports.push_back(
+                    {score(c.volumeMm3 + skinScore(directions[i]), base) + kOnSupportsPenaltyMm3, i});
         std::sort(byScore.begin(), byScore.end());
         std::vector<Vec3d> starts;
         for (const auto& [score0, i] : byScore) {
@@ -237,10 +255,10 @@ public:
             if (isNearAny(starts, direction) || !fits(direction)) continue;
             starts.push_back(direction);
             // Tilted by the cheap estimate (columns down to the bed), kept where the score agrees.
-            double support = supportOf(mesh, direction).volumeMm3;
-            const Vec3d tilted = tiltTowardsLess(
-                direction, support, [&](const Vec3d& d) { return supportOf(mesh, d).volumeMm3; },
-                [&](const Vec3d& d) { return hasFirstLayer(d) && fits(d); });
+            const auto cheap = [&](const Vec3d& d) { return supportOf(mesh, d).volumeMm3 + skinScore(d); };
+            double cheapScore = cheap(direction);
+            const Vec3d tilted = tiltTowardsLess(direction, cheapScore, cheap,
+                                                 [&](const Vec3d& d) { return hasFirstLayer(d) && fits(d); });
             const double tiltedScore = score(tilted);
             const double best = std::min(tiltedScore, score0);
             if (best < restScore) restScore = best, rest = tiltedScore < score0 ? tilted : direction;
@@ -303,6 +321,17 @@ public:
         return down;
     }
 
+    /// The cut face scores no worse than resting elsewhere with kCutFaceSupportShare of its
+    /// support and kCutFaceSupportSlackMm3 more, the larger first layer's tie-break aside (a flat
+    /// cut face on the bed is worth that).
+    bool isCutFaceWorthIt() const {
+        const double restSupportMm3 = supportColumnsMm3(mesh, rest);
+        const double baseUntied = baseScore + kBaseTieBreakMm3PerMm2 * firstLayerMm2(base->outwardNormal);
+        const double restUntied = restScore + kBaseTieBreakMm3PerMm2 * firstLayerMm2(rest);
+        return baseUntied <=
+               restUntied + (1.0 / kCutFaceSupportShare - 1.0) * restSupportMm3 + kCutFaceSupportSlackMm3;
+    }
+
     /// Why no cut face lies on the bed, and what the piece rests on instead.
     std::string note(const PrintOrientation& out) const {
         std::ostringstream note;
@@ -316,14 +345,16 @@ public:
         note << ", " << small << " under " << kMinCutFaceAreaMm2 << " mm², " << tooLarge
              << " too large for the printer";
         if (base)
-            note << ", and the best that fits needs " << baseScore / 1000.0 << " cm³ of support against "
-                 << out.support.volumeMm3 / 1000.0 << " cm³ this way";
+            note << ", and the best that fits needs " << supportColumnsMm3(mesh, base->outwardNormal) / 1000.0
+                 << " cm³ of support against " << out.support.volumeMm3 / 1000.0 << " cm³ this way";
         note << "); it rests on " << out.baseAreaMm2 << " mm²";
         if (out.isOnSupports) note << " and its supports (print it with supports)";
         return note.str();
     }
 
     const MeshD mesh;
+    const double volumeMm3;
+    const PrintTimeModel time;
     const std::vector<CutFace>& cutFaces;
     const Vec3d printer;
     const double flatToleranceMm;
@@ -394,17 +425,17 @@ double baseAreaMm2(const TriMesh& mesh, const Vec3d& down, double heightMm) {
 }
 
 PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFace>& cutFaces,
-                                  const Vec3d& printer, double flatToleranceMm, double overhangDeg) {
+                                  const Vec3d& printer, double flatToleranceMm, double overhangDeg,
+                                  const PrintTimeModel& time) {
     PrintOrientation out;
     if (meshMm.positions.empty()) return out;
-    OrientationSearch search(meshMm, cutFaces, printer, flatToleranceMm, overhangDeg);
+    OrientationSearch search(meshMm, cutFaces, printer, flatToleranceMm, overhangDeg, time);
     search.findFlatBase();
     search.findResting();
     search.findOnSupports();
     // A cut face wins unless resting elsewhere scores clearly better: a flat first layer is worth
     // a little support.
-    if (search.base && (!search.hasRest || search.baseScore <= search.restScore / kCutFaceSupportShare +
-                                                                   kCutFaceSupportSlackMm3)) {
+    if (search.base && (!search.hasRest || search.isCutFaceWorthIt())) {
         out.isCutFaceDown = true;
         out.downNormal = search.base->outwardNormal;
     } else if (search.hasRest) {

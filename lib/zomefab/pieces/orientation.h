@@ -63,6 +63,50 @@ struct SupportEstimate {
 };
 SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down, double overhangDeg = kOverhangDeg);
 
+/// What a slicer lays along a part's surface, per facet (docs/report.md, the estimator's model): a
+/// facet of area A whose normal makes an angle θ with "up" carries perimeters A·t_w·sin θ deep
+/// and top or bottom solid layers A·max(0, t_s·|cos θ| + m·sin θ − t_w·sin θ) deep, m only on
+/// shallow slopes (tan θ ≤ maxSlopeTan). Defaults: 0.45 mm lines, 3 perimeters, 0.2 mm layers, 5
+/// top and 5 bottom layers with a 0.27 mm first layer (report::PrintSettings' defaults, from which
+/// report::printTimeModel derives it; a test keeps the two equal).
+struct SkinModel {
+    double perimeterMm = 1.2642;  ///< t_w: 0.45 + 2 · (0.45 − 0.2 · (1 − π/4)), horizontal
+    double topMm = 1.0;           ///< t_s above: 5 layers of 0.2 mm
+    double bottomMm = 1.07;       ///< t_s below: 0.27 mm and 4 layers of 0.2 mm
+    double marginMm = 1.5;        ///< m: solid layers reach this far past a shallow slope's strip
+    double maxSlopeTan = 0.8889;  ///< 2h/w: a layer's exposed strip is at least half a line wide
+};
+
+/// Perimeter and solid-layer volumes of a part, mm³ (skinVolumes).
+struct SkinVolumes {
+    double perimeterMm3 = 0.0;
+    double solidMm3 = 0.0;
+};
+
+/// The skins of the closed mesh @p meshMm printed with @p up (unit) up: summed over its facets as
+/// SkinModel says, then, where they exceed @p volumeMm3 (walls thinner than two skins, all
+/// perimeter or solid), both scaled down to it. O(F), deterministic.
+SkinVolumes skinVolumes(const TriMesh& meshMm, const Vec3d& up, const SkinModel& model, double volumeMm3);
+
+/// Seconds per mm³ the orientation search weighs a direction with: report::PrintRates' fitted
+/// defaults at the default 20 % infill (report::printTimeModel derives them from any settings; a
+/// test keeps the defaults equal), but for the perimeters. A thin wall printed flat is all solid
+/// layers at 15–20 mm/s, standing it is perimeters at 30–60 mm/s: PrusaSlicer takes 3.2 h for a
+/// 100 × 100 × 2.4 mm plate lying flat, 3.2 h tilted 30°, and 1.9, 1.7, 1.9 and 1.9 h tilted 45°,
+/// 60°, 75° and standing, 0.24–0.28 s per mm³ of perimeters where the fit over thick parts
+/// (PrintRates::perimeterSPerMm3, 0.381) would say 2.6 h standing (docs/pieces.md, "Orientation").
+struct PrintTimeModel {
+    SkinModel skin;
+    double perimeterSPerMm3 = 0.27;  ///< a thin wall's perimeters (PrusaSlicer, 2.4 mm plates)
+    double solidSPerMm3 = 0.553;
+    double interiorSPerMm3 = 0.146 * 0.2 * 1.028;  ///< per mm³ of interior: sparse infill at 20 %
+    double supportSPerColumnMm3 = 0.34 * 0.34;     ///< supportShare × supportSPerMm3
+};
+
+/// Seconds to print the perimeters, solid layers and infill of the closed mesh @p meshMm with
+/// @p up up (supports not included) by @p model. O(F).
+double skinSeconds(const TriMesh& meshMm, const Vec3d& up, const PrintTimeModel& model = {});
+
 /// How a piece sits in the printer.
 struct PrintOrientation {
     bool fits = false;           ///< inside the build volume
@@ -84,17 +128,18 @@ struct PrintOrientation {
 /// candidates: the cut faces of at least kMinCutFaceAreaMm2 that no vertex lies beyond by more
 /// than @p flatToleranceMm (a flat base), and directions the piece rests on (the normals of the
 /// cut faces and of the mesh's largest facets, 256 sphere directions) with a first layer of at
-/// least 25 mm². Of those that fit, the one with the least support wins:
-/// each is scored by estimateSupport's volume (columns down to the piece below or the bed) plus a
-/// penalty for a first layer under kBrimBelowMm2; the best 8 resting directions are tilted in
-/// small steps towards less support. A cut face wins unless a resting direction scores clearly
-/// better (by 10 % and 2 cm³). A direction without the first layer competes too (isOnSupports)
-/// when 400 mm² of its support stands on the bed, at 50 cm³ more. When no direction has the first
-/// layer or that support, the largest contact that fits; when nothing fits, the orientation with the most
-/// room, fits = false. Support is what overhangs more than @p overhangDeg from the vertical needs
+/// least 25 mm². Of those that fit, the one with the least support and print time wins:
+/// each is scored by estimateSupport's volume (columns down to the piece below or the bed) plus
+/// skinSeconds by @p time in mm³ of columns that take as long, plus a penalty for a first layer
+/// under kBrimBelowMm2, less a tie-break for a larger first layer; the best 8 resting directions
+/// are tilted in small steps towards a smaller score. A cut face wins unless a resting direction
+/// scores clearly better (by 10 % of its support and 2 cm³). A direction without the first layer competes too
+/// (isOnSupports) when 400 mm² of its support stands on the bed, at 50 cm³ more. When no direction has the
+/// first layer or that support, the largest contact that fits; when nothing fits, the orientation with the
+/// most room, fits = false. Support is what overhangs more than @p overhangDeg from the vertical needs
 /// (Fabrication::overhangDeg). Deterministic.
 PrintOrientation orientForPrinter(const TriMesh& meshMm, const std::vector<CutFace>& cutFaces,
                                   const Vec3d& printerMm, double flatToleranceMm = kFlatToleranceMm,
-                                  double overhangDeg = kOverhangDeg);
+                                  double overhangDeg = kOverhangDeg, const PrintTimeModel& time = {});
 
 }  // namespace zomefab::pieces

@@ -235,10 +235,49 @@ SupportEstimate estimateSupport(const MeshD& m, const Vec3d& down) {
     return {supportOf(m, down).areaMm2, supportColumnsMm3(m, down)};
 }
 
+SkinVolumes skinVolumes(const MeshD& m, const Vec3d& up, const SkinModel& model, double volumeMm3) {
+    SkinVolumes out;
+    for (const Vec3d& vectorArea : m.vectorArea) {
+        const double area = norm(vectorArea);
+        if (area == 0.0) continue;
+        const double cosZ = dot(vectorArea, up) / area;
+        const double sinZ = std::sqrt(std::max(0.0, 1.0 - cosZ * cosZ));
+        // Normal-direction depth of the perimeters (horizontal t_w) and of the solid layers
+        // (vertical t_s); where both apply the deeper wins, the solid layers only add the rest.
+        const double wall = model.perimeterMm * sinZ;
+        double skin = (cosZ > 0.0 ? model.topMm : model.bottomMm) * std::abs(cosZ);
+        if (cosZ != 0.0 && sinZ <= model.maxSlopeTan * std::abs(cosZ)) skin += model.marginMm * sinZ;
+        out.perimeterMm3 += area * wall;
+        out.solidMm3 += area * std::max(0.0, skin - wall);
+    }
+    const double shell = out.perimeterMm3 + out.solidMm3;
+    if (shell > volumeMm3 && shell > 0.0) {
+        // Walls thinner than two skins: everything is perimeter or solid layer.
+        out.perimeterMm3 *= volumeMm3 / shell;
+        out.solidMm3 *= volumeMm3 / shell;
+    }
+    return out;
+}
+
+double skinSeconds(const MeshD& m, const Vec3d& up, const PrintTimeModel& model, double volumeMm3) {
+    const SkinVolumes skin = skinVolumes(m, up, model.skin, volumeMm3);
+    const double interior = std::max(0.0, volumeMm3 - skin.perimeterMm3 - skin.solidMm3);
+    return skin.perimeterMm3 * model.perimeterSPerMm3 + skin.solidMm3 * model.solidSPerMm3 +
+           interior * model.interiorSPerMm3;
+}
+
 }  // namespace detail
 
 SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down, double overhangDeg) {
     return detail::estimateSupport(MeshD(meshMm, overhangDeg), normalized(down));
+}
+
+SkinVolumes skinVolumes(const TriMesh& meshMm, const Vec3d& up, const SkinModel& model, double volumeMm3) {
+    return detail::skinVolumes(MeshD(meshMm), normalized(up), model, volumeMm3);
+}
+
+double skinSeconds(const TriMesh& meshMm, const Vec3d& up, const PrintTimeModel& model) {
+    return detail::skinSeconds(MeshD(meshMm), normalized(up), model, std::max(0.0, signedVolume(meshMm)));
 }
 
 }  // namespace zomefab::pieces

@@ -71,52 +71,43 @@ FilamentUse filamentUse(double filamentMm3, const FilamentOptions& filament) {
     return use;
 }
 
-PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const PrintRates& rates) {
+pieces::PrintTimeModel printTimeModel(const PrintSettings& s, const PrintRates& rates) {
     s.validate();
-    PrintEstimate e;
-    e.parts = 1;
-    if (part.triangles.empty()) return e;
     const double pi = std::acos(-1.0);
     const double h = s.layerHeightMm, w = s.extrusionWidthMm;
+    pieces::PrintTimeModel model;
     // Centre-line spacing of adjacent perimeters (PrusaSlicer's flow model: a rectangle with
     // semicircular ends, so neighbours overlap by h·(1 − π/4)).
     const double spacing = w - h * (1.0 - 0.25 * pi);
-    const double wallMm = w + double(s.perimeters - 1) * spacing;  // t_w, horizontal
-    const double topMm = double(s.topLayers) * h;                  // t_s above
-    const double bottomMm =
-        s.bottomLayers > 0 ? s.firstLayerHeightMm + double(s.bottomLayers - 1) * h : 0.0;  // t_s below
-
+    model.skin.perimeterMm = w + double(s.perimeters - 1) * spacing;  // t_w, horizontal
+    model.skin.topMm = double(s.topLayers) * h;                       // t_s above
+    model.skin.bottomMm = s.bottomLayers > 0 ? s.firstLayerHeightMm + double(s.bottomLayers - 1) * h : 0.0;
+    model.skin.marginMm = rates.skinMarginMm;
     // A sloped surface is exposed in a strip h / tan(slope) wide in each layer; PrusaSlicer keeps
     // (and widens by the margin) only strips at least half an extrusion width wide.
-    const double maxSlopeTan = 2.0 * h / w;
-    double perimeterMm3 = 0.0, solidMm3 = 0.0, zMin = 1e300, zMax = -1e300;
+    model.skin.maxSlopeTan = 2.0 * h / w;
+    model.perimeterSPerMm3 = rates.perimeterSPerMm3;
+    model.solidSPerMm3 = rates.solidSPerMm3;
+    model.interiorSPerMm3 =
+        s.infillPercent >= 100.0
+            ? rates.solidInfillSPerMm3
+            : rates.sparseInfillSPerMm3 * std::min(1.0, 0.01 * s.infillPercent * rates.sparseInfillFactor);
+    model.supportSPerColumnMm3 = rates.supportShare * rates.supportSPerMm3;
+    return model;
+}
+
+PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const PrintRates& rates) {
+    const pieces::PrintTimeModel model = printTimeModel(s, rates);
+    PrintEstimate e;
+    e.parts = 1;
+    if (part.triangles.empty()) return e;
+    const double h = s.layerHeightMm;
+    double zMin = 1e300, zMax = -1e300;
     for (const Vec3f& p : part.positions)
         zMin = std::min(zMin, double(p[2])), zMax = std::max(zMax, double(p[2]));
-    for (const Triangle& t : part.triangles) {
-        const Vec3f &a = part.positions[t[0]], &b = part.positions[t[1]], &c = part.positions[t[2]];
-        const double ux = double(b[0]) - a[0], uy = double(b[1]) - a[1], uz = double(b[2]) - a[2];
-        const double vx = double(c[0]) - a[0], vy = double(c[1]) - a[1], vz = double(c[2]) - a[2];
-        const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
-        const double twiceArea = std::sqrt(nx * nx + ny * ny + nz * nz);
-        if (twiceArea == 0.0) continue;
-        const double area = 0.5 * twiceArea;
-        const double cosZ = nz / twiceArea;
-        const double sinZ = std::sqrt(std::max(0.0, 1.0 - cosZ * cosZ));
-        // Normal-direction thickness of the perimeters (horizontal t_w) and of the solid layers
-        // (vertical t_s); where both apply the thicker one wins, the solid layers only add the rest.
-        const double wall = wallMm * sinZ;
-        double skin = (cosZ > 0.0 ? topMm : bottomMm) * std::abs(cosZ);
-        if (cosZ != 0.0 && sinZ <= maxSlopeTan * std::abs(cosZ)) skin += rates.skinMarginMm * sinZ;
-        perimeterMm3 += area * wall;
-        solidMm3 += area * std::max(0.0, skin - wall);
-    }
     const double volume = std::max(0.0, signedVolume(part));
-    const double shell = perimeterMm3 + solidMm3;
-    if (shell > volume && shell > 0.0) {
-        // Walls thinner than two shells: everything is perimeter or solid layer.
-        perimeterMm3 *= volume / shell;
-        solidMm3 *= volume / shell;
-    }
+    const pieces::SkinVolumes skin = pieces::skinVolumes(part, {0, 0, 1}, model.skin, volume);
+    const double perimeterMm3 = skin.perimeterMm3, solidMm3 = skin.solidMm3;
     const double interior = std::max(0.0, volume - perimeterMm3 - solidMm3);
     const bool isSolid = s.infillPercent >= 100.0;
     e.partVolumeMm3 = volume;

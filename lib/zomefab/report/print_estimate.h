@@ -105,6 +105,11 @@ struct FilamentUse {
 };
 FilamentUse filamentUse(double filamentMm3, const FilamentOptions& filament);
 
+/// The per-facet model and rates estimatePrint uses for @p settings, as the pieces' orientation
+/// search takes them (pieces::PrintTimeModel; its defaults are this at the default settings).
+/// @throw Error(Usage) as PrintSettings::validate.
+pieces::PrintTimeModel printTimeModel(const PrintSettings& settings, const PrintRates& rates = {});
+
 /// Estimates printing the closed, outward part @p part (mm, z up, as it will be printed).
 /// The model (docs/report.md): per facet of area A and unit normal n at angle θ to +z, the
 /// perimeters occupy A·t_w·sin θ and the top/bottom solid layers A·max(0, t_s·|cos θ| + m·sin θ −

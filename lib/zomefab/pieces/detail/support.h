@@ -83,6 +83,12 @@ double supportColumnsMm3(const MeshD& m, const Vec3d& down);
 /// estimateSupport on the double-precision mesh (@p down unit).
 SupportEstimate estimateSupport(const MeshD& m, const Vec3d& down);
 
+/// skinVolumes on the double-precision mesh (@p up unit).
+SkinVolumes skinVolumes(const MeshD& m, const Vec3d& up, const SkinModel& model, double volumeMm3);
+
+/// skinSeconds on the double-precision mesh of volume @p volumeMm3 (@p up unit).
+double skinSeconds(const MeshD& m, const Vec3d& up, const PrintTimeModel& model, double volumeMm3);
+
 /// Hill-climbs @p objective down from @p down by tilts of @p stepsDeg (each up to @p iterations
 /// times) about two perpendicular axes, keeping to directions where @p allowed; @p value is
 /// objective(@p down) on entry and at the result on return.
