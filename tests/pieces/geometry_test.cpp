@@ -687,6 +687,20 @@ TEST_CASE("orientation: support decides: a shelf piece lies on its flat top, not
     using pieces::detail::MeshD, pieces::detail::supportColumns;
     CHECK(supportColumns(MeshD(shelf), {0, 0, -1}).bedMm2 == doctest::Approx(50 * 60).epsilon(0.1));
     CHECK(supportColumns(MeshD(table), {0, 0, -1}).bedMm2 == 0.0);
+    // The footprint is the shelf's underside, outlined by its 220 mm rim, whether the columns stand
+    // on the bed or on the floor; SupportModel weighs the three measures.
+    for (const TriMesh* m : {&shelf, &table}) {
+        const SupportEstimate e = estimateSupport(*m, {0, 0, -1});
+        CHECK(e.footprintMm2 == doctest::Approx(50 * 60).epsilon(0.1));
+        CHECK(e.edgeMm == doctest::Approx(2 * (50 + 60)).epsilon(0.1));
+        const SupportModel model;
+        CHECK(e.filamentMm3 ==
+              doctest::Approx(model.interfaceMm * e.footprintMm2 + model.bodyShare * e.volumeMm3 +
+                              model.sheathMm * e.edgeMm * e.volumeMm3 / e.footprintMm2));
+    }
+    // A ragged footprint (the same area in strips) weighs more than a compact one of equal columns.
+    CHECK(supportFilamentMm3(3000, 1000, 3000 * 40, {}) > supportFilamentMm3(3000, 220, 3000 * 40, {}));
+    CHECK(supportFilamentMm3(0, 0, 0, {}) == 0.0);
 }
 
 /// A spinning top of shell: two cones base to base, @p radiusMm wide at the rim and @p halfMm high

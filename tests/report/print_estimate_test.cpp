@@ -73,7 +73,6 @@ TEST_CASE("print_estimate: the pieces' orientation weighs time with the estimato
     CHECK(theirs.perimeterSPerMm3 < mine.perimeterSPerMm3);
     CHECK(theirs.solidSPerMm3 == doctest::Approx(mine.solidSPerMm3));
     CHECK(theirs.interiorSPerMm3 == doctest::Approx(mine.interiorSPerMm3));
-    CHECK(theirs.supportSPerColumnMm3 == doctest::Approx(mine.supportSPerColumnMm3));
     // The same model: skinSeconds is estimatePrint's time without supports.
     const TriMesh sphere = makeSphere({0, 0, 30}, 30);
     CHECK(pieces::skinSeconds(sphere, {0, 0, 1}, mine) ==
@@ -198,9 +197,20 @@ TEST_CASE("print_estimate: supports under an overhang, none under a cube on the 
     s.supports = true;
     const PrintRates rates;
     const PrintEstimate withSupport = estimatePrint(table, s);
-    // The columns under the top: (40² − 10²) mm² × 30 mm, of which supportShare is printed.
-    // (The columns are sampled on a 2 mm grid: the top's rim and the stem's edge within a cell.)
-    CHECK(withSupport.supportMm3 == doctest::Approx(rates.supportShare * (1600 - 100) * 30).epsilon(0.15));
+    // The columns under the top, 30 mm tall on the 40 × 40 mm footprint outlined by 160 mm (the
+    // stem's top meets the top's underside: its cells count as overhang too), sampled on a 2 mm
+    // grid; the support filament is SupportModel's of those three.
+    const pieces::SupportEstimate columns =
+        pieces::estimateSupport(table, {0, 0, -1}, s.overhangDeg, rates.support);
+    CHECK(columns.footprintMm2 == doctest::Approx(1600).epsilon(0.1));
+    CHECK(columns.edgeMm == doctest::Approx(160).epsilon(0.1));
+    CHECK(columns.volumeMm3 == doctest::Approx(1600 * 30).epsilon(0.1));
+    CHECK(withSupport.supportMm3 ==
+          doctest::Approx(pieces::supportFilamentMm3(columns.footprintMm2, columns.edgeMm, columns.volumeMm3,
+                                                     rates.support)));
+    // 2.6 mm of interface over the footprint, 11.5 % of the columns, a 0.63 mm sheath round them.
+    CHECK(withSupport.supportMm3 ==
+          doctest::Approx(2.6 * 1600 + 0.115 * 48000 + 0.63 * 160 * 30).epsilon(0.1));
     s.supports = false;
     const PrintEstimate without = estimatePrint(table, s);
     CHECK(without.supportMm3 == 0.0);

@@ -51,6 +51,21 @@ constexpr double kOverhangDeg = 45.0;
 /// A piece whose first layer is smaller than this is advised a brim (about a 20 × 20 mm base).
 constexpr double kBrimBelowMm2 = 400.0;
 
+/// The support filament a slicer lays under overhangs, from the columns under them (SupportEstimate):
+/// interfaceMm × footprint + bodyShare × columns + sheathMm × the footprint's edge × the columns' mean
+/// height, mm³. Fitted (least squares on relative errors) to PrusaSlicer 2.5's automatic supports
+/// (0.2 mm layers) on the 32 pieces of the default runs of the bunny at 400 mm and the armadillo and
+/// elephant at 500 mm and on those three objects printed whole (docs/report.md, "Supports"). The edge
+/// term is what makes thin walls costly: the overhang of a tilted 2.4 mm wall is a ragged strip on
+/// the 2 mm grid, and PrusaSlicer's support under such a strip is several times the columns' share
+/// under one large flat overhang (a column share alone was 50 % high on whole objects and 13 % low
+/// on the pieces).
+struct SupportModel {
+    double interfaceMm = 2.6;  ///< per mm² of footprint: interface layers and the support's first layer
+    double bodyShare = 0.115;  ///< per mm³ of columns: the sparse body
+    double sheathMm = 0.63;    ///< per mm of footprint edge and mm of mean column height
+};
+
 /// What would need support were @p down (unit, the mesh's frame) to point down.
 struct SupportEstimate {
     /// Facets facing down more steeply than the overhang (kOverhangDeg unless given) from the
@@ -60,8 +75,14 @@ struct SupportEstimate {
     /// of the piece below it or from the bed (a slicer builds supports on the model too), sampled
     /// on a 2 mm grid, mm³. Solid: a slicer's sparse support uses a fraction of it.
     double volumeMm3 = 0.0;
+    double footprintMm2 = 0.0;  ///< the grid cells those columns stand in, mm²
+    double edgeMm = 0.0;        ///< the footprint's outline on the grid (cell sides), mm
+    double filamentMm3 = 0.0;   ///< support filament by SupportModel, mm³
 };
-SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down, double overhangDeg = kOverhangDeg);
+SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down, double overhangDeg = kOverhangDeg,
+                                const SupportModel& model = {});
+/// @p model's support filament for columns of @p volumeMm3 in @p footprintMm2 outlined by @p edgeMm, mm³.
+double supportFilamentMm3(double footprintMm2, double edgeMm, double volumeMm3, const SupportModel& model);
 
 /// What a slicer lays along a part's surface, per facet (docs/report.md, the estimator's model): a
 /// facet of area A whose normal makes an angle θ with "up" carries perimeters A·t_w·sin θ deep
@@ -100,7 +121,11 @@ struct PrintTimeModel {
     double perimeterSPerMm3 = 0.27;  ///< a thin wall's perimeters (PrusaSlicer, 2.4 mm plates)
     double solidSPerMm3 = 0.553;
     double interiorSPerMm3 = 0.146 * 0.2 * 1.028;  ///< per mm³ of interior: sparse infill at 20 %
-    double supportSPerColumnMm3 = 0.34 * 0.34;     ///< supportShare × supportSPerMm3
+    /// What a mm³ of support columns costs the search, s: a third of the columns printed at
+    /// 0.34 s/mm³, the estimator's support model before SupportModel. Kept: PrusaSlicer confirmed
+    /// the poses it picks, while scoring by SupportModel's filament (at 0.28 s/mm³) turned two of
+    /// the bunny's pieces off their supports onto poses 3 h slower (docs/pieces.md, "Orientation").
+    double supportSPerColumnMm3 = 0.34 * 0.34;
 };
 
 /// Seconds to print the perimeters, solid layers and infill of the closed mesh @p meshMm with

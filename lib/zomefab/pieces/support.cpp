@@ -168,6 +168,31 @@ SupportEstimate supportOf(const MeshD& m, const Vec3d& down) {
 /// Cell of the height map supportColumnsMm3 builds, mm.
 constexpr double kColumnCellMm = 2.0;
 
+namespace {
+
+/// Sorts @p cells and drops repeats; returns how many remain.
+size_t sortUnique(std::vector<uint64_t>& cells) {
+    std::sort(cells.begin(), cells.end());
+    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    return cells.size();
+}
+
+/// Sides of the sorted, unique cells (i << 32 | j) that border a cell not among them.
+size_t cellSides(const std::vector<uint64_t>& cells) {
+    const auto has = [&](uint64_t i, uint64_t j) {
+        return std::binary_search(cells.begin(), cells.end(), i << 32 | j);
+    };
+    size_t sides = 0;
+    for (const uint64_t c : cells) {
+        const uint64_t i = c >> 32, j = c & 0xffffffffu;
+        sides += size_t(!has(i + 1, j)) + size_t(i == 0 || !has(i - 1, j)) + size_t(!has(i, j + 1)) +
+                 size_t(j == 0 || !has(i, j - 1));
+    }
+    return sides;
+}
+
+}  // namespace
+
 /// The volume of support columns under the overhangs (as supportOf) when a column stops at the
 /// first up-facing surface of the piece below it, or the bed: what a slicer that builds supports
 /// on the model too would fill, mm³. For cup-shaped pieces the columns inside the cup end on the
@@ -175,7 +200,7 @@ constexpr double kColumnCellMm = 2.0;
 /// mesh is sampled on a kColumnCellMm grid in the bed's plane: each up-facing facet leaves its
 /// height at the cell centres it covers, each overhanging facet adds, per cell centre it covers,
 /// the gap to the highest of those below it.
-SupportColumns supportColumns(const MeshD& m, const Vec3d& down) {
+SupportColumns supportColumns(const MeshD& m, const Vec3d& down, bool measureFootprint) {
     const std::array<Vec3d, 3> rows = rotationDown(down);  // rows[2] = up
     std::vector<Vec3d> q(m.points.size());
     double x0 = 1e300, y0 = 1e300, z0 = 1e300;
@@ -208,6 +233,7 @@ SupportColumns supportColumns(const MeshD& m, const Vec3d& down) {
     std::sort(floors.begin(), floors.end());
     SupportColumns out;
     std::vector<uint64_t> onBed;  // cells with a column standing on the bed
+    std::vector<uint64_t> used;   // cells with any column
     for (size_t k = 0; k < m.triangles.size(); ++k) {
         if (!isOverhang(m.vectorArea[k], down, m.overhangSin)) continue;
         forCells(m.triangles[k], [&](uint64_t cell, double z) {
@@ -220,19 +246,28 @@ SupportColumns supportColumns(const MeshD& m, const Vec3d& down) {
             if (it != floors.begin() && std::prev(it)->first == cell) floor = std::prev(it)->second;
             else
                 onBed.push_back(cell);
+            if (measureFootprint) used.push_back(cell);
             out.volumeMm3 += (z - floor) * kColumnCellMm * kColumnCellMm;
         });
     }
-    std::sort(onBed.begin(), onBed.end());
-    out.bedMm2 =
-        double(std::unique(onBed.begin(), onBed.end()) - onBed.begin()) * kColumnCellMm * kColumnCellMm;
+    out.bedMm2 = double(sortUnique(onBed)) * kColumnCellMm * kColumnCellMm;
+    if (measureFootprint) {
+        out.footprintMm2 = double(sortUnique(used)) * kColumnCellMm * kColumnCellMm;
+        out.edgeMm = double(cellSides(used)) * kColumnCellMm;
+    }
     return out;
 }
 
 double supportColumnsMm3(const MeshD& m, const Vec3d& down) { return supportColumns(m, down).volumeMm3; }
 
-SupportEstimate estimateSupport(const MeshD& m, const Vec3d& down) {
-    return {supportOf(m, down).areaMm2, supportColumnsMm3(m, down)};
+double supportFilamentMm3(const SupportColumns& columns, const SupportModel& model) {
+    return pieces::supportFilamentMm3(columns.footprintMm2, columns.edgeMm, columns.volumeMm3, model);
+}
+
+SupportEstimate estimateSupport(const MeshD& m, const Vec3d& down, const SupportModel& model) {
+    const SupportColumns columns = supportColumns(m, down, true);
+    return {supportOf(m, down).areaMm2, columns.volumeMm3, columns.footprintMm2, columns.edgeMm,
+            supportFilamentMm3(columns, model)};
 }
 
 SkinVolumes skinVolumes(const MeshD& m, const Vec3d& up, const SkinModel& model, double volumeMm3) {
@@ -268,8 +303,16 @@ double skinSeconds(const MeshD& m, const Vec3d& up, const PrintTimeModel& model,
 
 }  // namespace detail
 
-SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down, double overhangDeg) {
-    return detail::estimateSupport(MeshD(meshMm, overhangDeg), normalized(down));
+double supportFilamentMm3(double footprintMm2, double edgeMm, double volumeMm3, const SupportModel& model) {
+    if (footprintMm2 <= 0.0) return 0.0;
+    const double meanHeightMm = volumeMm3 / footprintMm2;
+    return model.interfaceMm * footprintMm2 + model.bodyShare * volumeMm3 +
+           model.sheathMm * edgeMm * meanHeightMm;
+}
+
+SupportEstimate estimateSupport(const TriMesh& meshMm, const Vec3d& down, double overhangDeg,
+                                const SupportModel& model) {
+    return detail::estimateSupport(MeshD(meshMm, overhangDeg), normalized(down), model);
 }
 
 SkinVolumes skinVolumes(const TriMesh& meshMm, const Vec3d& up, const SkinModel& model, double volumeMm3) {

@@ -92,7 +92,6 @@ pieces::PrintTimeModel printTimeModel(const PrintSettings& s, const PrintRates& 
         s.infillPercent >= 100.0
             ? rates.solidInfillSPerMm3
             : rates.sparseInfillSPerMm3 * std::min(1.0, 0.01 * s.infillPercent * rates.sparseInfillFactor);
-    model.supportSPerColumnMm3 = rates.supportShare * rates.supportSPerMm3;
     return model;
 }
 
@@ -123,8 +122,7 @@ PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& s, const P
     e.seconds = e.perimeterMm3 * rates.perimeterSPerMm3 + e.solidMm3 * rates.solidSPerMm3 +
                 e.infillMm3 * (isSolid ? rates.solidInfillSPerMm3 : rates.sparseInfillSPerMm3);
     if (s.supports) {
-        e.supportMm3 =
-            rates.supportShare * pieces::estimateSupport(part, {0, 0, -1}, s.overhangDeg).volumeMm3;
+        e.supportMm3 = pieces::estimateSupport(part, {0, 0, -1}, s.overhangDeg, rates.support).filamentMm3;
         e.filamentMm3 += e.supportMm3;
         e.seconds += e.supportMm3 * rates.supportSPerMm3;
     }

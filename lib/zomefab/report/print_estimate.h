@@ -28,8 +28,8 @@ struct PrintSettings {
     int bottomLayers = 5;
     double infillPercent = 20.0;  ///< sparse infill density; 100 = solid (paper §7.2 "solid")
     /// Automatic supports under what overhangs (PrusaSlicer's --support-material
-    /// --support-material-auto; the estimator: PrintRates::supportShare of the columns under the
-    /// facets steeper than overhangDeg, pieces::estimateSupport).
+    /// --support-material-auto; the estimator: PrintRates::support's filament from the columns
+    /// under the facets steeper than overhangDeg, pieces::estimateSupport).
     bool supports = false;
     /// The steepest overhang printed without support, degrees from the vertical: the printer's
     /// (Fabrication::overhangDeg; costReport sets it). The estimator supports what is steeper; at
@@ -59,14 +59,14 @@ struct PrintRates {
     /// whose per-layer exposed strip h / tan(slope) is at least half an extrusion width (41° at
     /// 0.2 mm layers); fitted to PrusaSlicer's solid-infill volumes (docs/report.md).
     double skinMarginMm = 1.5;
-    /// Support filament per mm³ of the solid columns under the overhangs (pieces::estimateSupport's
-    /// volume): the least-squares fit (relative errors) to PrusaSlicer 2.5's automatic supports on
-    /// the 19 pieces of the bunny at 400 mm and the armadillo at 450 mm, 0.2 mm layers: 1.56 L
-    /// against 1.49 L in all, each piece within 53 % (rms 26 %) (docs/report.md, "Supports").
-    double supportShare = 0.34;
-    /// Support prints at 2.9 mm³/s: PrusaSlicer's times with and without supports of four of those
-    /// pieces, 0.33–0.36 s per mm³ of support.
-    double supportSPerMm3 = 0.34;
+    /// Support filament from the columns under the overhangs (pieces::estimateSupport): the
+    /// footprint, the columns and the footprint's edge, fitted to PrusaSlicer 2.5's automatic
+    /// supports on 32 pieces and 3 whole objects (pieces::SupportModel, docs/report.md "Supports").
+    pieces::SupportModel support;
+    /// Support prints at 3.6 mm³/s: with these rates for the rest, PrusaSlicer's times of the
+    /// bunny's pieces and of the bunny printed whole at 400 mm leave 0.26 and 0.31 s per mm³ of
+    /// its support (G-code: 0.23 s/mm³ of support moves alone, before accelerations and travel).
+    double supportSPerMm3 = 0.28;
 };
 
 /// Filament and its price. Default: the paper's 0.56 USD per metre of 2.85 mm PLA (§7.2).
@@ -106,7 +106,8 @@ struct FilamentUse {
 FilamentUse filamentUse(double filamentMm3, const FilamentOptions& filament);
 
 /// The per-facet model and rates estimatePrint uses for @p settings, as the pieces' orientation
-/// search takes them (pieces::PrintTimeModel; its defaults are this at the default settings).
+/// search takes them (pieces::PrintTimeModel; its defaults are this at the default settings, but
+/// for its thin-wall perimeter rate and its own weight of support columns).
 /// @throw Error(Usage) as PrintSettings::validate.
 pieces::PrintTimeModel printTimeModel(const PrintSettings& settings, const PrintRates& rates = {});
 
@@ -117,7 +118,7 @@ pieces::PrintTimeModel printTimeModel(const PrintSettings& settings, const Print
 /// m = PrintRates::skinMarginMm on shallow slopes (0 on steep ones); both are scaled
 /// down together when they exceed the part's volume (thin parts are solid). The rest of the volume
 /// is infill at the given density. Time = Σ volume·rate. With settings.supports, the support
-/// filament PrintRates::supportShare × the columns under the overhangs (pieces::estimateSupport,
+/// filament PrintRates::support makes of the columns under the overhangs (pieces::estimateSupport,
 /// down = −z) at supportSPerMm3. O(F + bed cells), deterministic.
 PrintEstimate estimatePrint(const TriMesh& part, const PrintSettings& settings, const PrintRates& rates = {});
 

@@ -229,11 +229,10 @@ std::string perPieceMarkdown(const RunRecord& run) {
         : run.cost.source == EstimateSource::PrusaSlicer
             ? "with PrusaSlicer's automatic supports where the overhangs need them; support: the "
               "filament PrusaSlicer lays down as support"
-            : formatNumbers(
+            : std::string(
                   "with automatic supports where the overhangs need them; support: the "
-                  "estimator's, %.0f %% of the solid columns under the overhangs (fitted to PrusaSlicer "
-                  "on 19 pieces: +5 %% in all, each within 53 %%, docs/report.md)",
-                  100 * run.cost.options.rates.supportShare);
+                  "estimator's, from the columns under the overhangs, their footprint and its edge "
+                  "(fitted to PrusaSlicer on 32 pieces and 3 objects printed whole, docs/report.md)");
     std::string md =
         "\n## Per piece\n\nEach piece's print on its own, " + supportNote +
         formatNumbers(

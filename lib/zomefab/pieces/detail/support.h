@@ -72,16 +72,22 @@ struct SupportColumns {
     /// The footprint of the columns that stand on the bed (not on the piece), mm²: with the
     /// piece's own first layer, what holds it on the bed.
     double bedMm2 = 0;
+    double footprintMm2 = 0;  ///< the cells with a column, mm² (measureFootprint)
+    double edgeMm = 0;        ///< the sides between those cells and the others, mm (measureFootprint)
 };
 
-/// Columns under the overhangs down to the first up-facing surface below, or the bed.
-SupportColumns supportColumns(const MeshD& m, const Vec3d& down);
+/// Columns under the overhangs down to the first up-facing surface below, or the bed; their
+/// footprint and its edge only with @p measureFootprint (the orientation search does without).
+SupportColumns supportColumns(const MeshD& m, const Vec3d& down, bool measureFootprint = false);
 
 /// estimateSupport's volume: supportColumns(@p m, @p down).volumeMm3.
 double supportColumnsMm3(const MeshD& m, const Vec3d& down);
 
 /// estimateSupport on the double-precision mesh (@p down unit).
-SupportEstimate estimateSupport(const MeshD& m, const Vec3d& down);
+SupportEstimate estimateSupport(const MeshD& m, const Vec3d& down, const SupportModel& model = {});
+
+/// @p model's support filament of @p columns (supportFilamentMm3), mm³.
+double supportFilamentMm3(const SupportColumns& columns, const SupportModel& model);
 
 /// skinVolumes on the double-precision mesh (@p up unit).
 SkinVolumes skinVolumes(const MeshD& m, const Vec3d& up, const SkinModel& model, double volumeMm3);
