@@ -294,10 +294,8 @@ pieces::PiecesOptions PiecesCli::resolve(bool isWallGiven) const {
         o.printWallMm = std::strtod(printWall.c_str(), &end);
         if (printWall.empty() || end != printWall.c_str() + printWall.size() ||
             !std::isfinite(o.printWallMm) || o.printWallMm < 0)
-            throw Error(ErrorCode::Usage,
-                        "--print-wall-mm must be auto, 0 (the shell's wall) or in [1, 200] mm, "
-                        "not \"" +
-                            printWall + "\"");
+            throw Error(ErrorCode::Usage, std::string("--print-wall-mm must be ") + pieces::kPrintWallValues +
+                                              ", not \"" + printWall + "\"");
     }
     o.label.isEnabled = !isUnlabelled;
     o.isGluingUnderHeld = !isNotGluing;

@@ -191,9 +191,8 @@ void checkPiecesOptions(const PiecesOptions& o) {
         throw Error(ErrorCode::Usage, "adaptivity must be in [0, 1], got " + formatNumber(o.adaptivity, 4));
     if (!(o.printWallMm == kPrintWallAuto || o.printWallMm == 0 ||
           (o.printWallMm >= 1 && o.printWallMm <= 200)))
-        throw Error(ErrorCode::Usage,
-                    "--print-wall-mm must be auto, 0 (the shell's wall) or in [1, 200] mm, got " +
-                        formatNumber(o.printWallMm, 4));
+        throw Error(ErrorCode::Usage, std::string("--print-wall-mm must be ") + kPrintWallValues + ", got " +
+                                          formatNumber(o.printWallMm, 4));
     checkTenonOptions(o.tenons);
     checkLabelOptions(o.label);
 }

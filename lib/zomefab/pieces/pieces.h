@@ -65,6 +65,9 @@ constexpr double kPrintWallAuto = -1.0;
 /// the flat bound and whose stress stays under half of what PLA takes across layers (docs/pieces.md,
 /// "Wall thickness"). Within the shell's band at voxels of at least 0.96 mm.
 constexpr double kDefaultPrintWallMm = 2.4;
+/// What --print-wall-mm takes, for the messages of the options' checks (checkPiecesOptions and the
+/// tools' parser).
+inline constexpr const char* kPrintWallValues = "auto, 0 (the shell's wall) or in [1, 200] mm";
 
 struct PiecesOptions {
     /// Connected pieces with less volume are merged into the neighbour they share the largest cut
