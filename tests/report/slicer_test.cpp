@@ -13,6 +13,7 @@
 #include "report_fixtures.h"
 #include "zomefab/core/error.h"
 #include "zomefab/io/mesh_io.h"
+#include "zomefab/mesh/scale.h"
 #include "zomefab/report/cost_report.h"
 #include "zomefab/report/mesh_clip.h"
 
@@ -170,11 +171,11 @@ TEST_CASE("slicer: an object printed whole, with supports, as the estimator coun
     // would be printed whole: its chin, belly and tail overhang (about 30 s of slicing). The support
     // model (pieces::SupportModel) gives 378 cm³ against PrusaSlicer's 408; a share of the columns
     // alone, fitted on pieces, said 578 (docs/report.md, "Supports").
-    TriMesh bunny = readMesh(ZOMEFAB_DATA_DIR "/bunny_npm_3674.stl");
-    float yMin = 1e30f, yMax = -1e30f;
-    for (const Vec3f& p : bunny.positions) yMin = std::min(yMin, p[1]), yMax = std::max(yMax, p[1]);
-    const float scale = 400.0f / (yMax - yMin);
-    for (Vec3f& p : bunny.positions) p = {p[0] * scale, -p[2] * scale, (p[1] - yMin) * scale};  // y up → z up
+    mesh::ScaleOptions scale;
+    scale.heightMm = 400.0;
+    scale.up = mesh::UpAxis::Y;
+    const TriMesh bunny =
+        mesh::scaleToMillimetres(readMesh(ZOMEFAB_DATA_DIR "/bunny_npm_3674.stl"), scale).mesh;
     PrintSettings s;
     s.supports = true;
     const PrintEstimate model = estimatePrint(bunny, s);
