@@ -10,14 +10,17 @@
 # refusals issue 18 allows); `ctest -L sweep` (make sweep) runs it so.
 set -u
 cd "$(dirname "$0")/.."
-build=${1:-build}; out=${2:-/tmp/zomefab-sweep}; shift 2 2>/dev/null || shift $#
-heights=("$@"); [ ${#heights[@]} -eq 0 ] && heights=(200 400 700)
-mkdir -p "$out"
+build=${1:-build}; out=${2:-/tmp/zomefab-sweep}
 # mesh:up (data/README.md: the CGAL dino and cheese are z up, the rest y up)
 # SWEEP_MESHES="name:up[:option] ..." runs those instead.
 meshes=(bunny_cgal_75k:y bunny_npm_3674:y armadillo_cgal_52k:y elephant_cgal_89k:y dino_cgal_8k:z
         cheese_cgal_18k:z bunny_stanford_open_69k:y:--repair)
+# size-sweep.sh --meshes: the list above, one name:up[:option] per line (tests/pipeline makes a test of each).
+[ "${1:-}" = --meshes ] && { printf '%s\n' "${meshes[@]}"; exit 0; }
 [ -n "${SWEEP_MESHES:-}" ] && read -r -a meshes <<< "$SWEEP_MESHES"
+shift 2 2>/dev/null || shift $#
+heights=("$@"); [ ${#heights[@]} -eq 0 ] && heights=(200 400 700)
+mkdir -p "$out"
 failed=0
 echo "| mesh | height | exit | s | peak MB | result |"
 echo "|---|---|---|---|---|---|"
