@@ -260,14 +260,10 @@ SupportColumns supportColumns(const MeshD& m, const Vec3d& down, bool measureFoo
 
 double supportColumnsMm3(const MeshD& m, const Vec3d& down) { return supportColumns(m, down).volumeMm3; }
 
-double supportFilamentMm3(const SupportColumns& columns, const SupportModel& model) {
-    return pieces::supportFilamentMm3(columns.footprintMm2, columns.edgeMm, columns.volumeMm3, model);
-}
-
 SupportEstimate estimateSupport(const MeshD& m, const Vec3d& down, const SupportModel& model) {
     const SupportColumns columns = supportColumns(m, down, true);
     return {supportOf(m, down).areaMm2, columns.volumeMm3, columns.footprintMm2, columns.edgeMm,
-            supportFilamentMm3(columns, model)};
+            pieces::supportFilamentMm3(columns.footprintMm2, columns.edgeMm, columns.volumeMm3, model)};
 }
 
 SkinVolumes skinVolumes(const MeshD& m, const Vec3d& up, const SkinModel& model, double volumeMm3) {

@@ -86,9 +86,6 @@ double supportColumnsMm3(const MeshD& m, const Vec3d& down);
 /// estimateSupport on the double-precision mesh (@p down unit).
 SupportEstimate estimateSupport(const MeshD& m, const Vec3d& down, const SupportModel& model = {});
 
-/// @p model's support filament of @p columns (supportFilamentMm3), mm³.
-double supportFilamentMm3(const SupportColumns& columns, const SupportModel& model);
-
 /// skinVolumes on the double-precision mesh (@p up unit).
 SkinVolumes skinVolumes(const MeshD& m, const Vec3d& up, const SkinModel& model, double volumeMm3);
 
