@@ -293,3 +293,23 @@ TEST_CASE("mounting: a tenon of a piece already on that lies in a later piece's 
     CHECK(candidates[0].rejection.empty());
     CHECK(lost.empty());
 }
+
+TEST_CASE("mounting: a piece no hole reaches and nothing can be glued onto is unplaceable") {
+    // Pieces 0–3, none placed. 0 has a usable candidate; 1 shares a 400 mm² face with 0 (a host to
+    // glue on, once 0 is on); 2 shares only 20 mm² with 0 and has no usable candidate; 3 touches
+    // nothing. A re-cut keeps 2's and 3's walls and only splits their faces.
+    mount::InstallationPlan plan;
+    plan.holeOfPiece = {-1, -1, -1, -1};
+    plan.problems = {"no order"};
+    PlannerInput input;
+    input.candidatesByHole = {{{kUp, {2, 1.0}}}, {}, {}, {}};
+    const FaceContacts faces = {{{0, 1}, {CutContact{{0, 0, 1}, 400}}},
+                                {{0, 2}, {CutContact{{1, 0, 0}, 20}}}};
+    CHECK(unplaceablePieces(plan, input, faces, 1.0) == std::vector<uint32_t>{2, 3});
+    // At 2 mm voxels 20 voxel faces are 80 mm², still too small; at 3 mm, 180 mm²: 2 has a host.
+    CHECK(unplaceablePieces(plan, input, faces, 2.0) == std::vector<uint32_t>{2, 3});
+    CHECK(unplaceablePieces(plan, input, faces, 3.0) == std::vector<uint32_t>{3});
+    // A piece placed (here glued into a group that pegs hold) is not one of them.
+    plan.holeOfPiece = {kUp, -1, -1, kUp};
+    CHECK(unplaceablePieces(plan, input, faces, 1.0) == std::vector<uint32_t>{2});
+}

@@ -460,6 +460,15 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         if (round == 0 && unplaced <= kMaxTunnelStuck &&
             cutTunnelLinings(out, field, cells, grouping, input, sweeps, opt, context) > 0)
             continue;
+        // A piece no hole reaches and nothing glues on stays so whatever is re-cut (the cheese at
+        // 400 mm, on a frame of 4 balls: a re-cut round and a plan, 127 s, for nothing).
+        if (const auto none = unplaceablePieces(out.plan, input, grouping.faces, field.voxelMm);
+            !none.empty()) {
+            context.detail("mounting: " + std::to_string(none.size()) + " piece(s) (piece " +
+                           std::to_string(none[0]) + (none.size() > 1 ? ", …" : "") +
+                           ") no ball's hole reaches and no cut face glues on: no re-cut places them");
+            break;
+        }
         if (keystones == 0 && round < kRecutRounds) {
             // Re-cutting that places no more pieces is given up: on the cheese at 700 mm the halves
             // of 116 pieces lining its tunnels were as stuck as the pieces (110 stuck bodies, then
@@ -541,6 +550,8 @@ void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping
     }
     const size_t pieceCount = out.pieces.size();
     for (Piece& piece : out.pieces) piece.wallMm = fabrication.wallMm, piece.isThinWall = false;
+    // What follows is for pieces that will be made; a plan with problems is refused (requireBuildable).
+    if (!out.plan.isBuildable()) return;
     // The printed wall, where thinner than the plan's (thin_wall.h): after the plan, before numbers.
     const ShellProbe thin = field.thinPhi.empty() ? probe : thinWallProbe(field, opt.printWallMm);
     if (!field.thinPhi.empty() && opt.tenons.maxPerPiece > 0) {

@@ -188,6 +188,15 @@ Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts
 /// Voxel faces between the pieces of two bodies (their contact area, in voxel faces).
 size_t bodyContact(const MountBody& a, const MountBody& b, const FaceContacts& faces);
 
+/// The pieces @p plan places nowhere that no cut can place: no usable tenon candidate along any
+/// direction (@p input) and no cut face with any piece large enough to glue them on across
+/// (GlueOnRule::minFaceMm2, @p faces). Re-cuts and keystones cut only pieces with candidates, and
+/// cutting its neighbours leaves its wall and the frame as they are and only splits the faces it
+/// shares, so such a piece stays placed nowhere until the pieces around it are joined (tunnel
+/// linings) or the frame grows.
+std::vector<uint32_t> unplaceablePieces(const mount::InstallationPlan& plan, const PlannerInput& input,
+                                        const FaceContacts& faces, double voxelMm);
+
 /// The plan: a body per piece, a piece no peg can hold glued onto a neighbour as it goes on
 /// (along a direction of @p holes), the disassembly's directions and order, and bodies that are
 /// stuck glued into one until an order exists. What could not be resolved is in
