@@ -7,6 +7,7 @@
 #include <doctest/doctest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -486,6 +487,14 @@ TEST_CASE("pieces: the engraved number is cut into the inner surface") {
         CHECK(isInsideMesh(m, below(underline.centerX, underline.centerY, o.label.depthMm + 1.0)));
     }
     CHECK(labelled >= 1);
+    // Without tenons (--max-tenons 0) there is no plan to carry out, and the pieces are numbered all
+    // the same.
+    o.tenons.maxPerPiece = 0;
+    o.tenons.minPerPiece = 0;
+    const Pieces plain = makePieces(shell(), frame(), Transform4d::identity(), cells,
+                                    printerOf({200, 200, 200}), o, RunContext::silent());
+    CHECK(std::count_if(plain.pieces.begin(), plain.pieces.end(),
+                        [](const Piece& p) { return bool(p.label); }) >= 1);
 }
 
 namespace {
