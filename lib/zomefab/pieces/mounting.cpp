@@ -249,15 +249,13 @@ std::vector<uint32_t> unplaceablePieces(const mount::InstallationPlan& plan, con
                                         const FaceContacts& faces, double voxelMm) {
     const size_t n = plan.holeOfPiece.size();
     std::vector<uint8_t> hasHost(n, 0);
-    const double minFaceVoxels = GlueOnRule{}.minFaceMm2 / (voxelMm * voxelMm);
     for (const auto& [pair, contacts] : faces)
         for (const CutContact& c : contacts)
-            if (double(c.voxelFaces) >= minFaceVoxels && pair.first < n && pair.second < n)
+            if (GlueOnRule{}.isLargeEnough(c.voxelFaces, voxelMm) && pair.first < n && pair.second < n)
                 hasHost[pair.first] = hasHost[pair.second] = 1;
     std::vector<uint32_t> out;
-    for (uint32_t p = 0; p < n && p < input.candidatesByHole.size(); ++p) {
+    for (uint32_t p = 0; p < n && p < input.candidatesByHole.size(); ++p)
         if (plan.holeOfPiece[p] < 0 && !hasHost[p] && input.candidatesByHole[p].empty()) out.push_back(p);
-    }
     return out;
 }
 

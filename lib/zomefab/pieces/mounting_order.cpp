@@ -378,7 +378,7 @@ std::vector<HostFace> hostFaces(const std::vector<MountBody>& bodies, uint32_t b
                 const auto it = faces.find({std::min(x, y), std::max(x, y)});
                 if (it == faces.end()) continue;
                 for (const CutContact& c : it->second)
-                    if (double(c.voxelFaces) * voxelMm * voxelMm >= rule.minFaceMm2)
+                    if (rule.isLargeEnough(c.voxelFaces, voxelMm))
                         out.push_back({a, x, y, x < y ? c.normal : scale(c.normal, -1.0)});
             }
     }

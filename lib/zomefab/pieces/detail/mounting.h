@@ -174,6 +174,10 @@ struct Disassembly {
 struct GlueOnRule {
     double minFaceMm2 = 150.0;
     double minCosine = 0.5;
+    /// A cut face of @p voxelFaces faces of @p voxelMm voxels is large enough to glue across.
+    bool isLargeEnough(size_t voxelFaces, double voxelMm) const {
+        return double(voxelFaces) * voxelMm * voxelMm >= minFaceMm2;
+    }
 };
 
 /// The disassembly of @p bodies over the directions each may take (free and with tenons, in rank
