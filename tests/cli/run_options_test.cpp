@@ -24,7 +24,7 @@ pipeline::RunOptions runWith(std::vector<std::string> args) {
 
 }  // namespace
 
-TEST_CASE("run options: the printed wall is 2.4 mm by default, the shell's wall when --shell-mm is given") {
+TEST_CASE("run options: the printed wall is chosen by default, the shell's wall when --shell-mm is given") {
     CHECK(runWith({}).pieces.printWallMm == pieces::kPrintWallAuto);
     CHECK(runWith({"--shell-mm", "16"}).pieces.printWallMm == 0);  // the paper's setting
     CHECK(runWith({"--shell-mm", "16", "--print-wall-mm", "2.4"}).pieces.printWallMm == 2.4);

@@ -836,6 +836,33 @@ TEST_CASE("label: seven-segment strokes, an underline, centred") {
     CHECK(hasUpperRight);
 }
 
+TEST_CASE("label: placed on a 1.8 mm wall whose surface lies within the flatness below the spot") {
+    // A flat wall 1.8 mm thick: material for 0 > z > −1.8, the cavity above (+z), piece 3 everywhere.
+    const double wall = 1.8;
+    ShellProbe probe;
+    probe.voxelMm = 1.0;
+    probe.wallMm = wall;
+    probe.signedDistanceMm = [wall](const Vec3d& p) { return std::max(p[2], -p[2] - wall); };
+    probe.pieceAt = [](const Vec3d&) { return int64_t(3); };
+    const LabelOptions o = labelOptionsForWall(LabelOptions{}, wall);  // 0.6 mm deep, within 0.3 mm
+    CHECK(o.depthMm == doctest::Approx(0.6));
+    CHECK(o.flatnessMm == doctest::Approx(0.3));
+    // The spot a ray found lies 0.25 mm inside the wall (the voxel surface is that far off): the
+    // number is still placed, with more than half the wall behind its deepest point. (A probe a
+    // whole voxel below the depth reached 1.85 mm, past the wall, and placed nothing.)
+    const std::vector<SurfaceSpot> spots{{{0, 0, -0.25}, {0, 0, 1}}};
+    std::string note;
+    const auto label = placeLabel("7", 3, spots, {}, TenonOptions{}, probe, o, &note);
+    REQUIRE(label.has_value());
+    CHECK(note.empty());
+    CHECK(-label->centerGridMm[2] + o.depthMm <= 0.5 * wall + 1e-9);
+    // Another piece's wall behind the spot, or no wall: no number.
+    probe.pieceAt = [](const Vec3d& p) { return p[2] < -1.0 ? int64_t(4) : int64_t(3); };
+    CHECK_FALSE(placeLabel("7", 3, spots, {}, TenonOptions{}, probe, o, &note).has_value());
+    probe.signedDistanceMm = [](const Vec3d& p) { return std::max(p[2], -p[2] - 0.9); };
+    CHECK_FALSE(placeLabel("7", 3, spots, {}, TenonOptions{}, probe, o, &note).has_value());
+}
+
 TEST_CASE("3mf: a deterministic OPC zip with the model in millimetres") {
     const TriMesh a = zomefab::test::makeBox({0, 0, 0}, {10, 20, 30});
     const TriMesh b = zomefab::test::makeBox({-5, -5, 0}, {5, 5, 5});

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Pieces printed with a wall thinner than the shell's (lib/zomefab/pieces/thin_wall.cpp): on a
 // 200 mm spherical shell of 8 mm with a B0 cube lattice inside, the plan made with the 8 mm wall,
-// the pieces printed with 2.4 mm where their pegs reach through it.
+// the pieces printed with the default thin wall (1.8 mm) where their pegs reach through it.
 #include "zomefab/pieces/detail/thin_wall.h"
 
 #include <doctest/doctest.h>
@@ -22,7 +22,7 @@ using namespace zomefab::pieces::test;
 
 namespace {
 
-constexpr double kThin = 2.4;
+constexpr double kThin = kDefaultPrintWallMm;
 
 constexpr double kRadius = kSphereRadiusMm, kShell = kSphereShellMm;
 
@@ -55,7 +55,7 @@ double distanceToStems(const Piece& piece, const Vec3d& p, const TenonOptions& o
 
 }  // namespace
 
-TEST_CASE("thin wall: the plan of the shell's wall, each piece printed 2.4 mm thin where its pegs reach") {
+TEST_CASE("thin wall: the plan of the shell's wall, each piece printed 1.8 mm thin where its pegs reach") {
     const Pieces thick = cutSphere(0), thin = cutSphere(kThin);
     REQUIRE(thick.pieces.size() == thin.pieces.size());
     // The plan is the shell's: the same directions and steps.
@@ -89,9 +89,9 @@ TEST_CASE("thin wall: the plan of the shell's wall, each piece printed 2.4 mm th
             CHECK(pegs.count({t.ball, t.hole}) == 1);
             CHECK(t.baseMm > q.tenons.front().shoulderMm);
         }
-        // A wall about 2.4/8 of the thick one's plastic, stems included.
+        // A wall about 1.8/8 of the thick one's plastic, stems included.
         CHECK(p.volumeMm3 < 0.55 * q.volumeMm3);
-        // Away from the stems the piece lies between the outer surface and 2.4 mm inside it, and
+        // Away from the stems the piece lies between the outer surface and 1.8 mm inside it, and
         // nothing of it is outside the sphere.
         const TriMesh m = gridMesh(p);
         size_t wall = 0, off = 0;
@@ -128,18 +128,20 @@ TEST_CASE("thin wall: a wall the shell's band or wall cannot give is refused, na
     CHECK_NOTHROW(detail::checkPrintWall(0.0, 4.0, 3.0, 1.0));  // off
 }
 
-TEST_CASE("thin wall: by default 2.4 mm where the shell allows it, else the shell's wall") {
+TEST_CASE("thin wall: by default 1.8 mm where the shell allows it, else the shell's wall") {
     using detail::resolvePrintWallMm;
     CHECK(PiecesOptions{}.printWallMm == kPrintWallAuto);
     CHECK(resolvePrintWallMm(kPrintWallAuto, 16.0, 3.0, 1.0) == kDefaultPrintWallMm);
     CHECK(resolvePrintWallMm(kPrintWallAuto, 7.0, 3.0, 1.0) == kDefaultPrintWallMm);
     CHECK(resolvePrintWallMm(kPrintWallAuto, 6.0, 3.0, 1.0) == 0);   // a thin shell is printed as it is
-    CHECK(resolvePrintWallMm(kPrintWallAuto, 16.0, 1.5, 0.5) == 0);  // a 1.5 mm band cannot hold 2.4
+    CHECK(resolvePrintWallMm(kPrintWallAuto, 16.0, 1.5, 0.5) == 0);  // a 1.5 mm band cannot hold 1.8
+    CHECK(resolvePrintWallMm(kPrintWallAuto, 16.0, 2.16, 0.72) == kDefaultPrintWallMm);
+    CHECK(resolvePrintWallMm(kPrintWallAuto, 16.0, 2.1, 0.7) == 0);
     CHECK(resolvePrintWallMm(kPrintWallAuto, 16.0, 2.91, 0.97) == kDefaultPrintWallMm);
     CHECK(resolvePrintWallMm(0, 16.0, 3.0, 1.0) == 0);
     CHECK(resolvePrintWallMm(2.0, 16.0, 3.0, 1.0) == 2.0);
     CHECK_THROWS_AS(resolvePrintWallMm(2.4, 16.0, 1.5, 0.5), Error);  // asked for: refused, not ignored
-    // The sphere's 8 mm shell at 1 mm voxels: the default is the 2.4 mm run.
+    // The sphere's 8 mm shell at 1 mm voxels: the default is the 1.8 mm run.
     const Pieces byDefault = cutSphere(kPrintWallAuto), thin = cutSphere(kThin);
     CHECK(byDefault.options.printWallMm == kThin);
     CHECK(byDefault.thinPieces == thin.thinPieces);
@@ -147,4 +149,15 @@ TEST_CASE("thin wall: by default 2.4 mm where the shell allows it, else the shel
     REQUIRE(byDefault.pieces.size() == thin.pieces.size());
     for (size_t i = 0; i < thin.pieces.size(); ++i)
         CHECK(byDefault.pieces[i].volumeMm3 == doctest::Approx(thin.pieces[i].volumeMm3));
+}
+
+TEST_CASE(
+    "thin wall: a stem grown again may run as much longer as the thin wall's inner surface lies deeper") {
+    TenonOptions o;  // 60 mm, tilt up to 60°: along a stem that steep, 14.2 mm deeper is 28.4 mm longer
+    const TenonOptions thin = detail::thinTenonOptions(o, 16.0, 1.8);
+    CHECK(thin.maxLengthMm == doctest::Approx(60.0 + 2 * 14.2));
+    CHECK(thin.maxTiltDeg == o.maxTiltDeg);
+    CHECK(detail::thinTenonOptions(o, 16.0, 16.0).maxLengthMm == doctest::Approx(60.0));
+    o.maxTiltDeg = 0;
+    CHECK(detail::thinTenonOptions(o, 8.0, 2.0).maxLengthMm == doctest::Approx(66.0));
 }

@@ -32,3 +32,17 @@ TEST_CASE("runSummaryFromJson refuses what is not a run report") {
     CHECK(s.pieces == 0);
     CHECK_FALSE(s.hasMaterialSaved);
 }
+
+TEST_CASE("runSummaryLines counts the pieces short of tenons in the right number") {
+    report::RunRecord run;
+    run.pieces.pieces.resize(3);
+    run.pieces.pieces[1].tenonShortfall["hole holds a strut"] = 1;
+    CHECK(report::runSummaryLines(run).front().find("(1 piece with fewer than planned)") !=
+          std::string::npos);
+    run.pieces.pieces[2].tenonShortfall["no ball in reach"] = 2;
+    CHECK(report::runSummaryLines(run).front().find("(2 pieces with fewer than planned)") !=
+          std::string::npos);
+    run.pieces.pieces[1].tenonShortfall.clear();
+    run.pieces.pieces[2].tenonShortfall.clear();
+    CHECK(report::runSummaryLines(run).front().find("fewer than planned") == std::string::npos);
+}

@@ -276,7 +276,7 @@ void PiecesCli::addTo(CLI::App& app) {
                  "pieces glued together as one");
     app.add_option("--print-wall-mm", printWall,
                    "Print each piece with this wall (mm) where its pegs reach through it; the plan and the "
-                   "frame keep --shell-mm. auto: 2.4 where the shell allows it, the shell's wall when "
+                   "frame keep --shell-mm. auto: 1.8 where the shell allows it, the shell's wall when "
                    "--shell-mm is given; 0 = print the shell's wall; at most 2.5 at 1 mm voxels")
         ->capture_default_str();
     app.add_flag("--no-label", isUnlabelled, "Do not engrave piece numbers");

@@ -32,7 +32,7 @@ void checkLabelOptions(const LabelOptions& options);
 
 /// @p options for a piece printed with a wall of @p wallMm: the engraving at most a third of the
 /// wall deep and the surface within a sixth of it under the number, so that at least half the wall
-/// stays behind the engraving (a 2.4 mm wall: 0.8 mm deep, within 0.4 mm; docs/pieces.md §3).
+/// stays behind the engraving (a 1.8 mm wall: 0.6 mm deep, within 0.3 mm; docs/pieces.md §3).
 LabelOptions labelOptionsForWall(const LabelOptions& options, double wallMm);
 
 /// Where a number is engraved.

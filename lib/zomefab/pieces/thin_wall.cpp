@@ -9,6 +9,7 @@
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
 #include "zomefab/pieces/detail/stages.h"
+#include "zomefab/pieces/detail/support.h"  // kPi
 
 namespace zomefab::pieces::detail {
 
@@ -65,6 +66,16 @@ bool crossesOtherPiece(const Tenon& t, const VoxelField& field, const TenonOptio
             }
     return false;
 }
+
+}  // namespace
+
+TenonOptions thinTenonOptions(const TenonOptions& o, double shellWallMm, double printWallMm) {
+    TenonOptions thin = o;
+    thin.maxLengthMm += (shellWallMm - printWallMm) / std::cos(o.maxTiltDeg * kPi / 180.0);
+    return thin;
+}
+
+namespace {
 
 /// @p piece's tenons grown again through the thin wall, or empty when one of them cannot be.
 std::vector<Tenon> thinTenons(const Piece& piece, const VoxelField& field, const zome::Structure& frame,
@@ -160,10 +171,11 @@ size_t thinPieces(Pieces& out, const VoxelField& field, const zome::Structure& f
     for (const auto& [a, b] : out.plan.glued) isGlued[a] = isGlued[b] = 1;
     for (const auto& [a, b] : out.plan.gluedOn) isGlued[a] = isGlued[b] = 1;
     const std::vector<std::pair<size_t, size_t>> voxels = voxelCounts(field, out.pieces.size());
+    const TenonOptions thinOptions = thinTenonOptions(options, shellWallMm, thin.wallMm);
     size_t count = 0;
     for (Piece& piece : out.pieces) {
         if (isGlued[piece.id] || !piece.pins.empty() || piece.tenons.empty()) continue;
-        std::vector<Tenon> tenons = thinTenons(piece, field, frame, frameToGridMm, thin, options);
+        std::vector<Tenon> tenons = thinTenons(piece, field, frame, frameToGridMm, thin, thinOptions);
         if (tenons.size() != piece.tenons.size()) continue;
         const auto [thick, thinVoxels] = voxels[piece.id];
         if (double(thinVoxels) < kMinThinShare * thin.wallMm / shellWallMm * double(thick)) continue;

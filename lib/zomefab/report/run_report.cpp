@@ -30,7 +30,9 @@ std::string frameLine(const RunRecord& run) {
            std::to_string(run.assembly.layers) + " layers to build), " +
            std::to_string(run.pieces.pieces.size()) + " printed pieces with " + std::to_string(tenons) +
            " tenons" +
-           (fewTenons ? " (" + std::to_string(fewTenons) + " pieces with fewer than planned)" : "");
+           (fewTenons ? " (" + std::to_string(fewTenons) + (fewTenons == 1 ? " piece" : " pieces") +
+                            " with fewer than planned)"
+                      : "");
 }
 
 std::string costLine(const CostCase& c) {

@@ -35,6 +35,13 @@ std::vector<float> thinWallPhi(const VoxelField& field, double printWallMm);
 /// owners of the field's voxels, wall @p printWallMm.
 ShellProbe thinWallProbe(const VoxelField& field, double printWallMm);
 
+/// The tenon options a stem grown again through a thin wall is held to: @p o with maxLengthMm
+/// longer by how much deeper the thin wall's inner surface lies along a stem at the steepest tilt,
+/// (shell − print) / cos(maxTiltDeg). The planned stem kept its limit; what it gains runs inside
+/// its own piece's thick wall (thinPieces checks that), so the limit's reason, reaching the wall
+/// across the forbidden zone, is met as it was.
+TenonOptions thinTenonOptions(const TenonOptions& o, double shellWallMm, double printWallMm);
+
 /// Each piece of @p out that can be printed thin: it is in no glued pair and carries no pin, each
 /// of its tenons (same ball and hole) is a candidate again through @p thin's wall that meets this
 /// piece, whose stem beyond the thick wall's inner surface crosses no other piece's wall, and the
