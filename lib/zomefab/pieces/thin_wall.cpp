@@ -67,16 +67,6 @@ bool crossesOtherPiece(const Tenon& t, const VoxelField& field, const TenonOptio
     return false;
 }
 
-}  // namespace
-
-TenonOptions thinTenonOptions(const TenonOptions& o, double shellWallMm, double printWallMm) {
-    TenonOptions thin = o;
-    thin.maxLengthMm += (shellWallMm - printWallMm) / std::cos(o.maxTiltDeg * kPi / 180.0);
-    return thin;
-}
-
-namespace {
-
 /// @p piece's tenons grown again through the thin wall, or empty when one of them cannot be.
 std::vector<Tenon> thinTenons(const Piece& piece, const VoxelField& field, const zome::Structure& frame,
                               const Transform4d& frameToGridMm, const ShellProbe& thin,
@@ -105,6 +95,12 @@ std::vector<std::pair<size_t, size_t>> voxelCounts(const VoxelField& field, size
 }
 
 }  // namespace
+
+TenonOptions thinTenonOptions(const TenonOptions& o, double shellWallMm, double printWallMm) {
+    TenonOptions thin = o;
+    thin.maxLengthMm += (shellWallMm - printWallMm) / std::cos(o.maxTiltDeg * kPi / 180.0);
+    return thin;
+}
 
 void checkPrintWall(double printWallMm, double shellWallMm, double backgroundMm, double voxelMm) {
     if (printWallMm == 0) return;
