@@ -822,11 +822,13 @@ TEST_CASE("label: seven-segment strokes, an underline, centred") {
     CHECK(box.min[1] == doctest::Approx(-box.max[1]));
     CHECK_THROWS_AS(labelStrokes("A", o), Error);
 
-    // The engraving solid: inside a stroke from depth below to above the surface.
+    // The strokes' solid: inside a stroke from depth + flatness below the plane to above it (the
+    // engraving is its part within the depth of the surface, wherever that lies in the flatness).
     PieceLabel label{"1", {0, 0, 0}, {0, 0, 1}, {0, 1, 0}, size[0], size[1]};
     const Stroke& s = one[0];
     CHECK(labelSignedDistanceMm(label, one, o, {s.centerX, s.centerY, -0.5 * o.depthMm}) < 0);
-    CHECK(labelSignedDistanceMm(label, one, o, {s.centerX, s.centerY, -o.depthMm - 0.3}) ==
+    CHECK(labelSignedDistanceMm(label, one, o, {s.centerX, s.centerY, -o.depthMm - 0.3}) < 0);
+    CHECK(labelSignedDistanceMm(label, one, o, {s.centerX, s.centerY, -o.depthMm - o.flatnessMm - 0.3}) ==
           doctest::Approx(0.3));
     // Readable from the cavity (+z): the right side of the text is +x = up × normal.
     const auto two = labelStrokes("2", o);  // "2" has its upper vertical on the right
@@ -847,6 +849,16 @@ TEST_CASE("label: placed on a 1.8 mm wall whose surface lies within the flatness
     const LabelOptions o = labelOptionsForWall(LabelOptions{}, wall);  // 0.6 mm deep, within 0.3 mm
     CHECK(o.depthMm == doctest::Approx(0.6));
     CHECK(o.flatnessMm == doctest::Approx(0.3));
+    // The 16 mm shell: 1.2 mm deep, within 2 mm; the solid ends 12.8 mm above the outer surface.
+    const LabelOptions thick = labelOptionsForWall(LabelOptions{}, 16.0);
+    CHECK(thick.depthMm == doctest::Approx(1.2));
+    CHECK(thick.flatnessMm == doctest::Approx(2.0));
+    // At most a third and a sixth of any wall: the solid (depth + flatness below the plane, the
+    // surface up to flatness above it) ends a depth short of the outer surface.
+    for (const double w : {1.2, 1.8, 2.4, 4.0, 16.0}) {
+        const LabelOptions l = labelOptionsForWall(LabelOptions{}, w);
+        CHECK(w - l.flatnessMm - (l.depthMm + l.flatnessMm) >= l.depthMm - 1e-12);
+    }
     // The spot a ray found lies 0.25 mm inside the wall (the voxel surface is that far off): the
     // number is still placed, with more than half the wall behind its deepest point. (A probe a
     // whole voxel below the depth reached 1.85 mm, past the wall, and placed nothing.)

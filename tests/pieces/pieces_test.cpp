@@ -449,44 +449,60 @@ TEST_CASE("pieces: the engraved number is cut into the inner surface") {
     // 12 mm digit on this small sphere does (docs/pieces.md, "Engraved number").
     o.printWallMm = 0;
     o.tenons.maxTiltDeg = 35;
-    const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells,
-                                     printerOf({200, 200, 200}), o, RunContext::silent());
-    checkClosedAndFits(result);
-    size_t labelled = 0;
-    for (const Piece& p : result.pieces) {
-        if (!p.label) {
-            CHECK(!p.labelNote.empty());
-            continue;
+    // 12 mm digits (the default) and 30 mm ones, which bend over the sphere.
+    for (const double heightMm : {12.0, 30.0}) {
+        CAPTURE(heightMm);
+        o.label.heightMm = heightMm;
+        const Pieces result = makePieces(shell(), frame(), Transform4d::identity(), cells,
+                                         printerOf({200, 200, 200}), o, RunContext::silent());
+        checkClosedAndFits(result);
+        size_t labelled = 0;
+        for (const Piece& p : result.pieces) {
+            if (!p.label) {
+                CHECK(!p.labelNote.empty());
+                continue;
+            }
+            ++labelled;
+            const PieceLabel& l = *p.label;
+            CHECK(l.text == std::to_string(p.id));
+            // On the inner surface, facing the cavity (towards the centre).
+            CHECK(norm(l.centerGridMm) == doctest::Approx(kRadius - kShell).epsilon(0.01));
+            CHECK(dot(l.normalGrid, normalized(l.centerGridMm)) < -0.9);
+            const TriMesh m = gridMesh(p);
+            const auto strokes = labelStrokes(l.text, o.label);
+            const Vec3d right = cross(l.upGrid, l.normalGrid);
+            auto at = [&](double x, double y, double z) {
+                return madd(madd(madd(l.centerGridMm, x, right), y, l.upGrid), z, l.normalGrid);
+            };
+            // The inner sphere below a point of the label's plane, along the normal (into the wall).
+            auto below = [&](double x, double y, double depth) {
+                const Vec3d q = at(x, y, 0);
+                const Vec3d n = l.normalGrid;  // points to the centre
+                // |q − s·n| = R − T for the s > 0 that reaches the sphere.
+                const double b = dot(q, n), c = dot(q, q) - std::pow(kRadius - kShell, 2);
+                const double s = b + std::sqrt(b * b - c);
+                return madd(q, -(s + depth), n);
+            };
+            // Half the depth under the underline's surface: engraved (outside the piece); beside the
+            // label at the same depth and below the engraving: wall.
+            const Stroke& underline = strokes.back();
+            CHECK(!isInsideMesh(m, below(underline.centerX, underline.centerY, 0.5 * o.label.depthMm)));
+            CHECK(isInsideMesh(m, below(0.5 * l.widthMm + 1.5, 0, 0.5 * o.label.depthMm)));
+            CHECK(isInsideMesh(m, below(underline.centerX, underline.centerY, o.label.depthMm + 1.0)));
+            // Digits 30 mm high bend over the sphere: the stroke farthest from the centre lies more
+            // than a millimetre below the label's plane, and is cut the depth into the sphere there
+            // (a cut from the plane went that much deeper; with the old 0.6 mm flatness no number).
+            if (o.label.heightMm < 20.0) continue;
+            const Stroke* far = &strokes[0];
+            for (const Stroke& st : strokes)
+                if (std::hypot(st.centerX, st.centerY) > std::hypot(far->centerX, far->centerY)) far = &st;
+            CHECK(std::hypot(far->centerX, far->centerY) > 15.0);
+            CHECK(!isInsideMesh(m, below(far->centerX, far->centerY, 0.5 * o.label.depthMm)));
+            CHECK(isInsideMesh(m, below(far->centerX, far->centerY, o.label.depthMm + 0.5)));
         }
-        ++labelled;
-        const PieceLabel& l = *p.label;
-        CHECK(l.text == std::to_string(p.id));
-        // On the inner surface, facing the cavity (towards the centre).
-        CHECK(norm(l.centerGridMm) == doctest::Approx(kRadius - kShell).epsilon(0.01));
-        CHECK(dot(l.normalGrid, normalized(l.centerGridMm)) < -0.9);
-        const TriMesh m = gridMesh(p);
-        const auto strokes = labelStrokes(l.text, o.label);
-        const Vec3d right = cross(l.upGrid, l.normalGrid);
-        auto at = [&](double x, double y, double z) {
-            return madd(madd(madd(l.centerGridMm, x, right), y, l.upGrid), z, l.normalGrid);
-        };
-        // The inner sphere below a point of the label's plane, along the normal (into the wall).
-        auto below = [&](double x, double y, double depth) {
-            const Vec3d q = at(x, y, 0);
-            const Vec3d n = l.normalGrid;  // points to the centre
-            // |q − s·n| = R − T for the s > 0 that reaches the sphere.
-            const double b = dot(q, n), c = dot(q, q) - std::pow(kRadius - kShell, 2);
-            const double s = b + std::sqrt(b * b - c);
-            return madd(q, -(s + depth), n);
-        };
-        // Half the depth under the underline's surface: engraved (outside the piece); beside the
-        // label at the same depth and below the engraving: wall.
-        const Stroke& underline = strokes.back();
-        CHECK(!isInsideMesh(m, below(underline.centerX, underline.centerY, 0.5 * o.label.depthMm)));
-        CHECK(isInsideMesh(m, below(0.5 * l.widthMm + 1.5, 0, 0.5 * o.label.depthMm)));
-        CHECK(isInsideMesh(m, below(underline.centerX, underline.centerY, o.label.depthMm + 1.0)));
+        CHECK(labelled >= 1);
     }
-    CHECK(labelled >= 1);
+    o.label = LabelOptions{};
     // Without tenons (--max-tenons 0) there is no plan to carry out, and the pieces are numbered all
     // the same.
     o.tenons.maxPerPiece = 0;

@@ -84,7 +84,8 @@ double labelSignedDistanceMm(const PieceLabel& label, const std::vector<Stroke>&
     const Vec3d right = cross(label.upGrid, label.normalGrid);
     const Vec3d d = sub(p, label.centerGridMm);
     const double x = dot(d, right), y = dot(d, label.upGrid), z = dot(d, label.normalGrid);
-    const double zMid = 0.5 * (kAboveSurfaceMm - o.depthMm), zHalf = 0.5 * (kAboveSurfaceMm + o.depthMm);
+    const double bottom = o.depthMm + o.flatnessMm;
+    const double zMid = 0.5 * (kAboveSurfaceMm - bottom), zHalf = 0.5 * (kAboveSurfaceMm + bottom);
     double best = 1e30;
     for (const Stroke& s : strokes)
         best = std::min(
@@ -97,7 +98,7 @@ Box3d labelBoundsMm(const PieceLabel& label, const LabelOptions& o) {
     Box3d box;
     for (double x : {-0.5 * label.widthMm, 0.5 * label.widthMm})
         for (double y : {-0.5 * label.heightMm, 0.5 * label.heightMm})
-            for (double z : {-o.depthMm, kAboveSurfaceMm})
+            for (double z : {-(o.depthMm + o.flatnessMm), kAboveSurfaceMm})
                 box.expand(
                     madd(madd(madd(label.centerGridMm, x, right), y, label.upGrid), z, label.normalGrid));
     return box;

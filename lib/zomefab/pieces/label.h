@@ -20,10 +20,11 @@ struct LabelOptions {
     /// Line width (and the gap above the underline); at least 2 voxels, else labels are skipped
     /// with a warning: 2.4 mm keeps the digits legible at the default 1 mm voxel.
     double strokeMm = 2.4;
-    double depthMm = 1.2;  ///< engraving depth below the inner surface
-    /// The surface may leave the label's plane by this much under the label (so the engraving is
-    /// between depthMm − flatnessMm and depthMm + flatnessMm deep).
-    double flatnessMm = 0.6;
+    double depthMm = 1.2;  ///< engraving depth below the inner surface (following the surface)
+    /// The surface may leave the label's plane by this much under the label: the digits are drawn
+    /// on the plane and cut depthMm into the surface beneath it, so this bounds how far they are
+    /// bent, and keeps the cut half a wall from the outer surface (labelOptionsForWall).
+    double flatnessMm = 2.0;
     double marginMm = 2.0;  ///< clear distance to cut faces, wall edges and tenons
 };
 
@@ -31,8 +32,10 @@ struct LabelOptions {
 void checkLabelOptions(const LabelOptions& options);
 
 /// @p options for a piece printed with a wall of @p wallMm: the engraving at most a third of the
-/// wall deep and the surface within a sixth of it under the number, so that at least half the wall
-/// stays behind the engraving (a 1.8 mm wall: 0.6 mm deep, within 0.3 mm; docs/pieces.md §3).
+/// wall deep and the surface within a sixth of it under the number. Then the strokes' solid
+/// (depth + flatness below the plane) ends at least the depth above the outer surface, so the
+/// engraving never reaches it, and half the wall stays behind the engraving's deepest point
+/// (a 1.8 mm wall: 0.6 mm deep, within 0.3 mm; the 16 mm shell: 1.2 mm, within 2 mm; docs/pieces.md §3).
 LabelOptions labelOptionsForWall(const LabelOptions& options, double wallMm);
 
 /// Where a number is engraved.
@@ -57,8 +60,10 @@ std::vector<Stroke> labelStrokes(const std::string& text, const LabelOptions& op
 /// Width and height of the box around labelStrokes().
 Vec3d labelSizeMm(const std::string& text, const LabelOptions& options);
 
-/// Signed distance (negative inside) to the engraving solid: the strokes extruded from depthMm
-/// below the label's plane to 2 mm above it (into the cavity), grid mm.
+/// Signed distance (negative inside) to the strokes extruded from depthMm + flatnessMm below the
+/// label's plane to 2 mm above it (into the cavity), grid mm. The engraving is this solid's
+/// part within depthMm of the inner surface (pieces/piece_grid.cpp): the surface moved depthMm
+/// into the wall under the strokes, however it curves within flatnessMm of the plane.
 double labelSignedDistanceMm(const PieceLabel& label, const std::vector<Stroke>& strokes,
                              const LabelOptions& options, const Vec3d& pGridMm);
 /// Axis-aligned box (grid mm) around the engraving solid.

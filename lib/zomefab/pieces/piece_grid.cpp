@@ -135,7 +135,9 @@ void addPins(FloatGrid& grid, openvdb::BoolTree& mask, const VoxelField& field, 
     }
 }
 
-/// The engraved number: difference, ψ = max(ψ, −glyph).
+/// The engraved number: difference, ψ = max(ψ, −glyph), where the glyph is the strokes' solid
+/// within depthMm of the surface (−glyph = min(−strokes, ψ + depthMm)): under the strokes the
+/// inner surface moves depthMm into the wall wherever it lies within the label's flatness.
 void engraveLabel(FloatGrid& grid, openvdb::BoolTree& mask, const VoxelField& field, const PieceLabel& label,
                   const LabelOptions& o) {
     const float bg = field.background;
@@ -145,9 +147,10 @@ void engraveLabel(FloatGrid& grid, openvdb::BoolTree& mask, const VoxelField& fi
     mask.fill(box, true, true);
     for (auto it = box.begin(); it; ++it) {
         const Coord ijk = *it;
-        const double e = -labelSignedDistanceMm(label, strokes, o, field.world(ijk));
-        if (e <= -bg) continue;
         const float old = acc.getValue(ijk);
+        const double e =
+            std::min(-labelSignedDistanceMm(label, strokes, o, field.world(ijk)), old + o.depthMm);
+        if (e <= -bg) continue;
         if (e <= old) continue;
         if (e >= bg)
             acc.setValueOff(ijk, bg);
