@@ -23,7 +23,7 @@ struct LabelOptions {
     double depthMm = 1.2;  ///< engraving depth below the inner surface (following the surface)
     /// The surface may leave the label's plane by this much under the label: the digits are drawn
     /// on the plane and cut depthMm into the surface beneath it, so this bounds how far they are
-    /// bent, and keeps the cut half a wall from the outer surface (labelOptionsForWall).
+    /// bent (on a thin wall, labelOptionsForWall bounds it to keep the cut off the outer surface).
     double flatnessMm = 2.0;
     double marginMm = 2.0;  ///< clear distance to cut faces, wall edges and tenons
 };
@@ -34,7 +34,7 @@ void checkLabelOptions(const LabelOptions& options);
 /// @p options for a piece printed with a wall of @p wallMm: the engraving at most a third of the
 /// wall deep and the surface within a sixth of it under the number. Then the strokes' solid
 /// (depth + flatness below the plane) ends at least the depth above the outer surface, so the
-/// engraving never reaches it, and half the wall stays behind the engraving's deepest point
+/// engraving never reaches it, and two thirds of the wall stay behind the engraving
 /// (a 1.8 mm wall: 0.6 mm deep, within 0.3 mm; the 16 mm shell: 1.2 mm, within 2 mm; docs/pieces.md §3).
 LabelOptions labelOptionsForWall(const LabelOptions& options, double wallMm);
 

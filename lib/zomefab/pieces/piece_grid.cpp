@@ -148,6 +148,9 @@ void engraveLabel(FloatGrid& grid, openvdb::BoolTree& mask, const VoxelField& fi
     for (auto it = box.begin(); it; ++it) {
         const Coord ijk = *it;
         const float old = acc.getValue(ijk);
+        // Beyond the band ψ is only known to be below −bg: a cut deeper than the band (a depth
+        // above 3 voxels: --voxel-mm under 0.4 mm) stops at the band instead of opening the wall.
+        if (old <= -bg) continue;
         const double e =
             std::min(-labelSignedDistanceMm(label, strokes, o, field.world(ijk)), old + o.depthMm);
         if (e <= -bg) continue;
