@@ -177,10 +177,11 @@ std::optional<PieceLabel> placeLabel(const std::string& text, uint32_t piece,
         if (!isOk) continue;
         ++tried;
         double deviation = 0;
-        // Half the wall stays behind the number when the wall reaches a quarter voxel below the
-        // deepest the engraving can go (depth + flatness): depth + flatness is at most half the
-        // wall (labelOptionsForWall). A probe a whole voxel below the depth asked for more than the
-        // wall has on a 1.8 mm wall (1.6 mm of it, within 0.3 mm of the surface's deviation).
+        // The wall must reach a quarter voxel below the deepest the engraving can go (depth below
+        // a surface up to flatness below the plane): depth + flatness is at most half the wall
+        // (labelOptionsForWall), and two thirds of it stay behind the number. A probe a whole voxel
+        // below the depth asked for more than the wall has on a 1.8 mm wall (1.6 mm of it, within
+        // 0.3 mm of the surface's deviation).
         const double wallProbe = o.depthMm + o.flatnessMm + 0.25 * probe.voxelMm;
         for (double x = -halfW - o.marginMm; x <= halfW + o.marginMm + 1e-9 && isOk; x += sample) {
             for (double y = -halfH - o.marginMm; y <= halfH + o.marginMm + 1e-9 && isOk; y += sample) {

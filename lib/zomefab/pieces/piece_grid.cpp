@@ -153,8 +153,7 @@ void engraveLabel(FloatGrid& grid, openvdb::BoolTree& mask, const VoxelField& fi
         if (old <= -bg) continue;
         const double e =
             std::min(-labelSignedDistanceMm(label, strokes, o, field.world(ijk)), old + o.depthMm);
-        if (e <= -bg) continue;
-        if (e <= old) continue;
+        if (e <= old) continue;  // also every e ≤ −bg, as old > −bg here
         if (e >= bg)
             acc.setValueOff(ijk, bg);
         else
