@@ -11,6 +11,7 @@
 #include "mesh_distance.h"
 #include "test_util.h"
 #include "zomefab/core/error.h"
+#include "zomefab/core/vec.h"
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/mesh/scale.h"
 #include "zomefab/sdf/vdb_file.h"
@@ -19,8 +20,6 @@ using namespace zomefab;
 using namespace zomefab::sdf;
 
 namespace {
-
-const double kPi = std::acos(-1.0);
 
 double radius(const Vec3f& p, const Vec3d& c) {
     return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) +

@@ -6,6 +6,7 @@
 #include "mesh_distance.h"
 #include "test_util.h"
 #include "zomefab/core/error.h"
+#include "zomefab/core/vec.h"
 #include "zomefab/io/mesh_io.h"
 #include "zomefab/mesh/scale.h"
 #include "zomefab/sdf/level_set.h"
@@ -14,8 +15,6 @@ using namespace zomefab;
 using namespace zomefab::sdf;
 
 namespace {
-
-const double kPi = std::acos(-1.0);
 
 TriMesh bunnyMm(const std::string& file, double heightMm) {
     mesh::ScaleOptions scale;

@@ -10,6 +10,9 @@
 
 namespace zomefab {
 
+/// π, for the angles the stages convert (degrees in options, radians in std::cos).
+inline constexpr double kPi = 3.14159265358979323846;
+
 inline Vec3d add(const Vec3d& a, const Vec3d& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
 inline Vec3d sub(const Vec3d& a, const Vec3d& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 inline Vec3d scale(const Vec3d& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }

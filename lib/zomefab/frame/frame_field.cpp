@@ -8,10 +8,6 @@
 
 namespace zomefab::frame {
 
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-}  // namespace
-
 Transform4d rotationAboutZ(double degrees) {
     const double a = degrees * kPi / 180.0;
     const double c = std::cos(a), s = std::sin(a);

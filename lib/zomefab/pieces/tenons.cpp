@@ -32,7 +32,6 @@ Vec3d ShellProbe::normalAt(const Vec3d& p) const {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 /// The prism stops this short of the ball's face (mm): the voxel mesher rounds the concave edge
 /// where a prism would meet a peg into a fillet of up to half a voxel, which would sit in the hole's
 /// mouth; the exact peg mesh spans the gap instead.

@@ -8,8 +8,8 @@
 
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
+#include "zomefab/core/vec.h"
 #include "zomefab/pieces/detail/stages.h"
-#include "zomefab/pieces/detail/support.h"  // kPi
 
 namespace zomefab::pieces::detail {
 

@@ -18,8 +18,6 @@ namespace zomefab::verify::detail {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// Ids of objects bucketed by the cells of a uniform grid their boxes touch.
 class BoxGrid {
 public:

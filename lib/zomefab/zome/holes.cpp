@@ -4,11 +4,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "zomefab/core/vec.h"
+
 namespace zomefab::zome {
 
 namespace {
-
-const double kPi = std::acos(-1.0);
 
 /// A regular polygon with @p n corners on the circle of @p circumradius, corner 0 on +x.
 std::vector<std::array<double, 2>> regularPolygon(int n, double circumradius) {

@@ -15,6 +15,7 @@
 #include "zomefab/core/fabrication.h"
 #include "zomefab/core/format.h"
 #include "zomefab/core/run_context.h"
+#include "zomefab/core/vec.h"
 #include "zomefab/partition/alpha_expansion.h"
 #include "zomefab/partition/face_graph.h"
 #include "zomefab/partition/partition.h"
@@ -23,7 +24,6 @@
 namespace zomefab::partition::detail {
 
 inline constexpr uint32_t kNone = 0xFFFFFFFFu;
-inline const double kPi = std::acos(-1.0);
 /// Balls and struts are taken this much larger in the mountability test (mm): the pieces stage's
 /// frame margin (1 mm) and a millimetre for the faces standing in for the wall's voxels.
 inline constexpr double kMountMarginMm = 2.0;

@@ -14,8 +14,6 @@
 
 namespace zomefab::pieces::detail {
 
-inline constexpr double kPi = 3.14159265358979323846;
-
 /// The mesh in double precision, with each triangle's vector area (area × unit outward normal),
 /// and the printer's steepest overhang without support (Fabrication::overhangDeg) its support is
 /// estimated with.
