@@ -79,7 +79,7 @@ double windingNumber(const TriMesh& mesh, const std::vector<uint32_t>& triangles
         const double den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
         sum += 2.0 * std::atan2(num, den);
     }
-    return sum / (4.0 * std::acos(-1.0));
+    return sum / (4.0 * kPi);
 }
 
 double triangleArea(const TriMesh& mesh, uint32_t a, uint32_t b, uint32_t c) {

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "zomefab/core/vec.h"
+
 namespace zomefab::partition {
 
 namespace {
@@ -129,7 +131,7 @@ PrinterFit fitInPrinter(const std::vector<Vec3d>& pts, const Vec3d& printerMm, d
     Mat3 pca = eig.eigenvectors().transpose();  // rows = principal axes
     if (pca.determinant() < 0) pca.row(0) *= -1.0;
 
-    const double deg = std::acos(-1.0) / 180.0;
+    const double deg = kPi / 180.0;
     Mat3 best = Mat3::Identity();
     Score bestScore = scoreOf(sample, best, printerSorted, marginMm);
     // A long piece may only fit along the printer's diagonal: a third start turns the major

@@ -27,6 +27,9 @@ constexpr double kAboveSurfaceMm = 2.0;
 
 double digitWidthMm(const LabelOptions& o) { return std::max(0.55 * o.heightMm, 3.0 * o.strokeMm); }
 double digitGapMm(const LabelOptions& o) { return std::max(0.3 * o.heightMm, 1.5 * o.strokeMm); }
+/// How far below the label's plane the strokes' solid reaches: the depth under a surface that may
+/// lie flatnessMm below the plane.
+double solidBottomMm(const LabelOptions& o) { return o.depthMm + o.flatnessMm; }
 
 }  // namespace
 
@@ -84,7 +87,7 @@ double labelSignedDistanceMm(const PieceLabel& label, const std::vector<Stroke>&
     const Vec3d right = cross(label.upGrid, label.normalGrid);
     const Vec3d d = sub(p, label.centerGridMm);
     const double x = dot(d, right), y = dot(d, label.upGrid), z = dot(d, label.normalGrid);
-    const double bottom = o.depthMm + o.flatnessMm;
+    const double bottom = solidBottomMm(o);
     const double zMid = 0.5 * (kAboveSurfaceMm - bottom), zHalf = 0.5 * (kAboveSurfaceMm + bottom);
     double best = 1e30;
     for (const Stroke& s : strokes)
@@ -98,7 +101,7 @@ Box3d labelBoundsMm(const PieceLabel& label, const LabelOptions& o) {
     Box3d box;
     for (double x : {-0.5 * label.widthMm, 0.5 * label.widthMm})
         for (double y : {-0.5 * label.heightMm, 0.5 * label.heightMm})
-            for (double z : {-(o.depthMm + o.flatnessMm), kAboveSurfaceMm})
+            for (double z : {-solidBottomMm(o), kAboveSurfaceMm})
                 box.expand(
                     madd(madd(madd(label.centerGridMm, x, right), y, label.upGrid), z, label.normalGrid));
     return box;
@@ -182,7 +185,7 @@ std::optional<PieceLabel> placeLabel(const std::string& text, uint32_t piece,
         // (labelOptionsForWall), and two thirds of it stay behind the number. A probe a whole voxel
         // below the depth asked for more than the wall has on a 1.8 mm wall (1.6 mm of it, within
         // 0.3 mm of the surface's deviation).
-        const double wallProbe = o.depthMm + o.flatnessMm + 0.25 * probe.voxelMm;
+        const double wallProbe = solidBottomMm(o) + 0.25 * probe.voxelMm;
         for (double x = -halfW - o.marginMm; x <= halfW + o.marginMm + 1e-9 && isOk; x += sample) {
             for (double y = -halfH - o.marginMm; y <= halfH + o.marginMm + 1e-9 && isOk; y += sample) {
                 const Vec3d q = at(x, y);

@@ -9,7 +9,7 @@ namespace zomefab::pieces::detail {
 
 std::vector<TunnelGroup> tunnelGroups(const std::vector<uint32_t>& pieces,
                                       const std::vector<std::vector<Vec3d>>& freeAlong, size_t minPieces) {
-    const double sameAxis = std::cos(M_PI / 180.0);
+    const double sameAxis = std::cos(kPi / 180.0);
     std::vector<uint8_t> isTaken(pieces.size(), 0);
     std::vector<TunnelGroup> out;
     for (;;) {

@@ -9,6 +9,7 @@
 
 #include "zomefab/core/error.h"
 #include "zomefab/core/fabrication.h"
+#include "zomefab/core/vec.h"
 #include "zomefab/pieces/orientation.h"
 #include "zomefab/report/mesh_clip.h"
 
@@ -62,8 +63,7 @@ PrintEstimate& PrintEstimate::operator+=(const PrintEstimate& o) {
 }
 
 FilamentUse filamentUse(double filamentMm3, const FilamentOptions& filament) {
-    const double pi = std::acos(-1.0);
-    const double crossSectionMm2 = 0.25 * pi * filament.diameterMm * filament.diameterMm;
+    const double crossSectionMm2 = 0.25 * kPi * filament.diameterMm * filament.diameterMm;
     FilamentUse use;
     use.lengthM = filamentMm3 / crossSectionMm2 / 1000.0;
     use.massG = filamentMm3 / 1000.0 * filament.densityGPerCm3;
@@ -73,12 +73,11 @@ FilamentUse filamentUse(double filamentMm3, const FilamentOptions& filament) {
 
 pieces::PrintTimeModel printTimeModel(const PrintSettings& s, const PrintRates& rates) {
     s.validate();
-    const double pi = std::acos(-1.0);
     const double h = s.layerHeightMm, w = s.extrusionWidthMm;
     pieces::PrintTimeModel model;
     // Centre-line spacing of adjacent perimeters (PrusaSlicer's flow model: a rectangle with
     // semicircular ends, so neighbours overlap by h·(1 − π/4)).
-    const double spacing = w - h * (1.0 - 0.25 * pi);
+    const double spacing = w - h * (1.0 - 0.25 * kPi);
     model.skin.perimeterMm = w + double(s.perimeters - 1) * spacing;  // t_w, horizontal
     model.skin.topMm = double(s.topLayers) * h;                       // t_s above
     model.skin.bottomMm = s.bottomLayers > 0 ? s.firstLayerHeightMm + double(s.bottomLayers - 1) * h : 0.0;
