@@ -2,11 +2,15 @@
 /// @file Tunnel linings (docs/mounting.md, "Tunnels"): the pieces free of the frame along a tunnel's
 /// axis both ways make it a tunnel's, the pieces free along it one way (round a mouth) join them, a
 /// limb (free outward only) is no tunnel; slabs are cut at the same offsets in every piece and
-/// never leave a sliver.
+/// never leave a sliver. Tunnels that cross: their cores (free lines enclosed by the object), which
+/// cross, and the pieces lining them, said when a plan places them nowhere.
 #include "zomefab/pieces/detail/tunnels.h"
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <string>
 #include <vector>
 
 using namespace zomefab;
@@ -68,4 +72,93 @@ TEST_CASE(
     REQUIRE(!groups.empty());
     CHECK(std::abs(groups[0].axis[0]) > 0.99);
     CHECK(groups[0].pieces == std::vector<uint32_t>{0, 1});
+}
+
+namespace {
+
+/// A solid cube [0, n)³ of 1 mm voxels as a shell field (every voxel inside), less round tunnels of
+/// radius @p r through its middle along each axis in @p axes; voxels within @p liningMm of a tunnel's
+/// wall are owned by piece 0, the rest by piece 1.
+VoxelField cubeWithTunnels(int n, double r, const std::vector<int>& axes, double liningMm) {
+    FloatGrid::Ptr grid = FloatGrid::create(3.0f);
+    FloatGrid::Accessor acc = grid->getAccessor();
+    const double c = 0.5 * (n - 1);
+    auto wallDistance = [&](const Coord& ijk) {  // to the nearest tunnel's wall, negative inside it
+        double d = 1e9;
+        for (int a : axes) {
+            const double u = ijk[(a + 1) % 3] - c, v = ijk[(a + 2) % 3] - c;
+            d = std::min(d, std::sqrt(u * u + v * v) - r);
+        }
+        return d;
+    };
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+            for (int k = 0; k < n; ++k)
+                if (wallDistance(Coord(i, j, k)) > 0.0) acc.setValue(Coord(i, j, k), -1.0f);
+    VoxelField field = buildField(*grid);
+    field.owner.assign(field.phi.size(), kNone);
+    for (size_t s = 0; s < field.phi.size(); ++s)
+        if (field.isInside(s)) field.owner[s] = wallDistance(field.coordOf(s)) <= liningMm ? 0 : 1;
+    return field;
+}
+
+}  // namespace
+
+TEST_CASE("tunnelCores: the free lines enclosed by the object, not those round it, and none too narrow") {
+    AxisShadow shadow = emptyShadow(0, Coord(0, 0, 0), Coord(40, 40, 40));
+    for (int j = 0; j <= 40; ++j)
+        for (int k = 0; k <= 40; ++k)
+            if ((j - 20) * (j - 20) + (k - 20) * (k - 20) > 64) markHit(shadow, Coord(5, j, k));
+    const std::vector<TunnelCore> cores = tunnelCores(shadow, 2.0, 10.0);
+    REQUIRE(cores.size() == 1);  // the hole; the ring of columns round the cube reaches the border
+    CHECK(cores[0].axis == 0);
+    CHECK(cores[0].diameterMm == doctest::Approx(2.0 * 2.0 * 8.0).epsilon(0.1));  // 8 voxels of 2 mm
+    CHECK(std::binary_search(cores[0].columns.begin(), cores[0].columns.end(), std::array<int, 2>{20, 20}));
+    CHECK(tunnelCores(shadow, 2.0, 40.0).empty());  // narrower than asked
+    CHECK(shadow.isHitAt(0, 0));
+    CHECK_FALSE(shadow.isHitAt(20, 20));
+    CHECK_FALSE(shadow.isHitAt(-100, 20));  // off the shadow: nothing there
+}
+
+TEST_CASE("coresCross: prisms along two axes meet where they share the third axis's values") {
+    TunnelCore x{0, {{10, 10}, {10, 11}, {11, 10}}, 5.0};  // along x: (y, z), z ∈ {10, 11}
+    TunnelCore y{1, {{11, 30}, {12, 30}}, 5.0};            // along y: (z, x), z ∈ {11, 12}
+    TunnelCore high{1, {{40, 30}}, 5.0};                   // along y at z = 40
+    TunnelCore other{0, {{30, 11}}, 5.0};                  // along x too
+    CHECK(coresCross(x, y));
+    CHECK(coresCross(y, x));
+    CHECK_FALSE(coresCross(x, high));
+    CHECK_FALSE(coresCross(x, other));  // parallel prisms do not cross
+}
+
+TEST_CASE(
+    "crossingTunnels: tunnels along x and y that cross; their lining pieces; one tunnel alone crosses none") {
+    const VoxelField crossing = cubeWithTunnels(64, 10.0, {0, 1}, 4.0);
+    const CrossingTunnels both = crossingTunnels(crossing, 2, 8.0, 6.0);
+    CHECK(both.tunnels == 2);
+    CHECK(both.crossings == 1);
+    CHECK(both.meanDiameterMm == doctest::Approx(20.0).epsilon(0.1));
+    REQUIRE(both.liningShare.size() == 2);
+    CHECK(both.liningShare[0] > 0.95);  // the lining
+    CHECK(both.liningShare[1] < 0.4);   // the rest of the cube: only round the mouths
+    const VoxelField single = cubeWithTunnels(64, 10.0, {0}, 4.0);
+    const CrossingTunnels one = crossingTunnels(single, 2, 8.0, 6.0);
+    CHECK(one.tunnels == 0);
+    CHECK(one.crossings == 0);
+    CHECK(one.liningShare[0] == 0.0);
+}
+
+TEST_CASE("crossingTunnelNote: said when most of the pieces placed nowhere line crossing tunnels") {
+    CrossingTunnels t;
+    t.tunnels = 4, t.crossings = 4, t.meanDiameterMm = 84.0;
+    t.liningShare = {0.9, 0.8, 0.7, 0.6, 0.1, 0.2, 0.95};
+    size_t lining = 99;
+    const std::string note = crossingTunnelNote(t, {0, 1, 2, 3, 4, 5}, 4, &lining);
+    CHECK(lining == 4);
+    CHECK(note.find("4 of the 6 pieces placed nowhere line tunnels") == 0);
+    CHECK(note.find("4 straight tunnels about 84 mm across, 4 pairs of them crossing)") != std::string::npos);
+    CHECK(crossingTunnelNote(t, {0, 4, 5}, 1, &lining).empty());  // 1 of 3: not most
+    CHECK(lining == 0);
+    CHECK(crossingTunnelNote(t, {0, 1, 6}, 4, &lining).empty());  // all 3, fewer than 4
+    CHECK(crossingTunnelNote(t, {0, 1, 2, 3, 4, 5, 6}, 4, nullptr).find("5 of the 7") == 0);
 }

@@ -203,7 +203,8 @@ void requireBuildable(const Pieces& pieces) {
     std::string list;
     for (size_t i = 0; i < problems.size() && i < 3; ++i) list += (i ? "; " : "") + problems[i];
     if (problems.size() > 3) list += "; and " + std::to_string(problems.size() - 3) + " more";
-    throw NotBuildable("the pieces cannot be put on the frame: " + list, problems.size());
+    throw NotBuildable("the pieces cannot be put on the frame: " + list, problems.size(),
+                       pieces.crossingTunnelPieces > 0);
 }
 
 Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,

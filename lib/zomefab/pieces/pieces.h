@@ -201,6 +201,9 @@ struct Pieces {
     /// isGrowingFrame): the frame to build and to write. Empty when none was grown.
     std::optional<zome::Structure> grownFrame;
     size_t frameStrutsGrown = 0;
+    /// A plan that failed: how many of the pieces it placed nowhere line tunnels that cross each
+    /// other (docs/mounting.md, "What is not done"); 0 when they are not most of them.
+    size_t crossingTunnelPieces = 0;
     Transform4d frameToGridMm;
     Transform4d gridTransformMm;  ///< the shell's LevelSetInfo::transformMm (input mesh → grid mm)
     PiecesOptions options;
@@ -222,13 +225,19 @@ public:
 /// What requireBuildable throws: the installation plan has problems (exit 3).
 class NotBuildable : public Error {
 public:
-    explicit NotBuildable(const std::string& message, size_t problemCount = 1)
-        : Error(ErrorCode::ProcessingFailed, message), mProblemCount(problemCount) {}
+    explicit NotBuildable(const std::string& message, size_t problemCount = 1, bool isInTheObject = false)
+        : Error(ErrorCode::ProcessingFailed, message),
+          mProblemCount(problemCount),
+          mIsInTheObject(isInTheObject) {}
     /// How many problems the plan recorded (a piece no direction mounts, a group stuck in a cycle).
     size_t problemCount() const { return mProblemCount; }
+    /// The problem lies in the object, not in where the partition cut it (pieces lining tunnels that
+    /// cross): partitioning again does not help.
+    bool isInTheObject() const { return mIsInTheObject; }
 
 private:
     size_t mProblemCount;
+    bool mIsInTheObject;
 };
 
 /// @throw NotBuildable "the pieces cannot be put on the frame: ..." naming the plan's problems,

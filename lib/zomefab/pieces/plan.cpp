@@ -552,7 +552,10 @@ void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping
     for (Piece& piece : out.pieces) piece.wallMm = fabrication.wallMm, piece.isThinWall = false;
     // What follows is for pieces that will be made; a plan with problems is refused (requireBuildable),
     // unless there are no tenons to plan (--max-tenons 0: pieces without a plan, numbered all the same).
-    if (opt.tenons.maxPerPiece > 0 && !out.plan.isBuildable()) return;
+    if (opt.tenons.maxPerPiece > 0 && !out.plan.isBuildable()) {
+        noteCrossingTunnels(out, field, fabrication.wallMm);
+        return;
+    }
     // The printed wall, where thinner than the plan's (thin_wall.h): after the plan, before numbers.
     const ShellProbe thin = field.thinPhi.empty() ? probe : thinWallProbe(field, opt.printWallMm);
     if (!field.thinPhi.empty() && opt.tenons.maxPerPiece > 0) {

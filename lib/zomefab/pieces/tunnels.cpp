@@ -4,6 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <iterator>
+#include <limits>
+
+#include "zomefab/core/format.h"
 
 namespace zomefab::pieces::detail {
 
@@ -67,6 +72,189 @@ std::vector<double> slabOffsets(const std::vector<double>& t, double slabMm, siz
         kept = below;
     }
     return out;
+}
+
+AxisShadow emptyShadow(int axis, const Coord& lo, const Coord& hi) {
+    AxisShadow s;
+    s.axis = axis;
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    s.loU = lo[u] - 1, s.loV = lo[v] - 1;
+    s.sizeU = hi[u] - lo[u] + 3, s.sizeV = hi[v] - lo[v] + 3;
+    s.isHit.assign(size_t(s.sizeU) * size_t(s.sizeV), 0);
+    return s;
+}
+
+void markHit(AxisShadow& shadow, const Coord& ijk) {
+    const int u = ijk[(shadow.axis + 1) % 3] - shadow.loU, v = ijk[(shadow.axis + 2) % 3] - shadow.loV;
+    if (u >= 0 && v >= 0 && u < shadow.sizeU && v < shadow.sizeV)
+        shadow.isHit[size_t(u) * size_t(shadow.sizeV) + size_t(v)] = 1;
+}
+
+std::array<AxisShadow, 3> shadowsOf(const VoxelField& field) {
+    Coord lo(std::numeric_limits<int>::max()), hi(std::numeric_limits<int>::min());
+    bool any = false;
+    for (size_t s = 0; s < field.isActive.size(); ++s) {
+        if (!field.isInside(s)) continue;
+        const Coord c = field.coordOf(s);
+        lo.minComponent(c), hi.maxComponent(c), any = true;
+    }
+    std::array<AxisShadow, 3> out;
+    if (!any) return out;
+    for (int a = 0; a < 3; ++a) out[size_t(a)] = emptyShadow(a, lo, hi);
+    for (size_t s = 0; s < field.isActive.size(); ++s)
+        if (field.isInside(s))
+            for (AxisShadow& shadow : out) markHit(shadow, field.coordOf(s));
+    return out;
+}
+
+std::vector<TunnelCore> tunnelCores(const AxisShadow& shadow, double voxelMm, double minDiameterMm) {
+    std::vector<TunnelCore> out;
+    const int nu = shadow.sizeU, nv = shadow.sizeV;
+    std::vector<uint8_t> isSeen(shadow.isHit);  // hit columns count as seen
+    for (int u0 = 0; u0 < nu; ++u0)
+        for (int v0 = 0; v0 < nv; ++v0) {
+            if (isSeen[size_t(u0) * size_t(nv) + size_t(v0)]) continue;
+            // One connected set of free columns (4-neighbours), flood-filled.
+            TunnelCore core;
+            core.axis = shadow.axis;
+            bool isOpen = false;  // reaches the border: the lines round the object
+            std::deque<std::array<int, 2>> queue{{u0, v0}};
+            isSeen[size_t(u0) * size_t(nv) + size_t(v0)] = 1;
+            while (!queue.empty()) {
+                const auto [u, v] = queue.front();
+                queue.pop_front();
+                core.columns.push_back({u + shadow.loU, v + shadow.loV});
+                isOpen |= u == 0 || v == 0 || u == nu - 1 || v == nv - 1;
+                const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
+                for (int k = 0; k < 4; ++k) {
+                    const int a = u + du[k], b = v + dv[k];
+                    if (a < 0 || b < 0 || a >= nu || b >= nv || isSeen[size_t(a) * size_t(nv) + size_t(b)])
+                        continue;
+                    isSeen[size_t(a) * size_t(nv) + size_t(b)] = 1;
+                    queue.push_back({a, b});
+                }
+            }
+            core.diameterMm = 2.0 * std::sqrt(double(core.columns.size()) / kPi) * voxelMm;
+            if (isOpen || core.diameterMm < minDiameterMm) continue;
+            std::sort(core.columns.begin(), core.columns.end());
+            out.push_back(std::move(core));
+        }
+    return out;
+}
+
+namespace {
+
+/// The values of grid axis @p c that @p core's columns take (sorted, unique).
+std::vector<int> valuesAlong(const TunnelCore& core, int c) {
+    const size_t k = (core.axis + 1) % 3 == c ? 0 : 1;
+    std::vector<int> out;
+    for (const auto& column : core.columns) out.push_back(column[k]);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+}  // namespace
+
+bool coresCross(const TunnelCore& a, const TunnelCore& b) {
+    if (a.axis == b.axis) return false;
+    const int c = 3 - a.axis - b.axis;
+    const std::vector<int> x = valuesAlong(a, c), y = valuesAlong(b, c);
+    std::vector<int> both;
+    std::set_intersection(x.begin(), x.end(), y.begin(), y.end(), std::back_inserter(both));
+    return !both.empty();
+}
+
+CrossingTunnels crossingTunnels(const VoxelField& field, size_t pieceCount, double minDiameterMm,
+                                double reachMm) {
+    CrossingTunnels out;
+    out.liningShare.assign(pieceCount, 0.0);
+    std::array<AxisShadow, 3> shadows = shadowsOf(field);
+    if (shadows[0].isHit.empty()) return out;
+    std::vector<TunnelCore> cores;
+    for (const AxisShadow& s : shadows)
+        for (TunnelCore& core : tunnelCores(s, field.voxelMm, minDiameterMm))
+            cores.push_back(std::move(core));
+    std::vector<uint8_t> crosses(cores.size(), 0);
+    for (size_t i = 0; i < cores.size(); ++i)
+        for (size_t j = i + 1; j < cores.size(); ++j)
+            if (coresCross(cores[i], cores[j])) crosses[i] = crosses[j] = 1, ++out.crossings;
+    // Near a crossing core: within reach of one of its columns across its axis (a disc stamped
+    // round each column at the core's edge, next to a column the object hits).
+    std::array<AxisShadow, 3> near = shadows;
+    for (AxisShadow& s : near) std::fill(s.isHit.begin(), s.isHit.end(), 0);
+    const int r = int(std::ceil(reachMm / field.voxelMm));
+    for (size_t i = 0; i < cores.size(); ++i) {
+        if (!crosses[i]) continue;
+        ++out.tunnels;
+        out.meanDiameterMm += cores[i].diameterMm;
+        const AxisShadow& hit = shadows[size_t(cores[i].axis)];
+        AxisShadow& mark = near[size_t(cores[i].axis)];
+        const int u = (cores[i].axis + 1) % 3, v = (cores[i].axis + 2) % 3;
+        for (const auto& [cu, cv] : cores[i].columns) {
+            if (!hit.isHitAt(cu + 1, cv) && !hit.isHitAt(cu - 1, cv) && !hit.isHitAt(cu, cv + 1) &&
+                !hit.isHitAt(cu, cv - 1))
+                continue;
+            for (int du = -r; du <= r; ++du)
+                for (int dv = -r; dv <= r; ++dv)
+                    if (du * du + dv * dv <= r * r) {
+                        Coord c(0, 0, 0);
+                        c[u] = cu + du, c[v] = cv + dv;
+                        markHit(mark, c);
+                    }
+        }
+    }
+    if (out.tunnels == 0) return out;
+    out.meanDiameterMm /= double(out.tunnels);
+    std::vector<size_t> total(pieceCount, 0), lining(pieceCount, 0);
+    for (size_t s = 0; s < field.isActive.size(); ++s) {
+        if (!field.isInside(s) || field.owner[s] >= pieceCount) continue;
+        const Coord c = field.coordOf(s);
+        ++total[field.owner[s]];
+        const int a[3] = {c[1], c[2], c[0]}, b[3] = {c[2], c[0], c[1]};  // (u, v) along x, y, z
+        bool isNear = false;
+        for (int k = 0; k < 3 && !isNear; ++k) isNear = near[size_t(k)].isHitAt(a[k], b[k]);
+        lining[field.owner[s]] += isNear ? 1 : 0;
+    }
+    for (size_t p = 0; p < pieceCount; ++p)
+        out.liningShare[p] = total[p] > 0 ? double(lining[p]) / double(total[p]) : 0.0;
+    return out;
+}
+
+std::string crossingTunnelNote(const CrossingTunnels& tunnels, const std::vector<uint32_t>& unplaced,
+                               size_t minPieces, size_t* lining) {
+    size_t count = 0;
+    for (uint32_t p : unplaced)
+        count += p < tunnels.liningShare.size() && tunnels.liningShare[p] >= 0.5 ? 1 : 0;
+    if (lining) *lining = 0;
+    if (count < std::max<size_t>(1, minPieces) || 2 * count < unplaced.size()) return "";
+    if (lining) *lining = count;
+    return std::to_string(count) + " of the " + std::to_string(unplaced.size()) +
+           " pieces placed nowhere line tunnels through the object that cross each other (" +
+           std::to_string(tunnels.tunnels) + " straight tunnels about " +
+           formatNumbers("%.0f", tunnels.meanDiameterMm) + " mm across, " +
+           std::to_string(tunnels.crossings) + (tunnels.crossings == 1 ? " pair" : " pairs") +
+           " of them crossing): such a piece can reach its place only along its tunnel, past the crossings, "
+           "and zomefab cuts a lining into rings that slide in along their tunnel only where no other "
+           "tunnel crosses it (docs/mounting.md, \"What is not done\"), so partitioning again does "
+           "not help";
+}
+
+size_t noteCrossingTunnels(Pieces& out, const VoxelField& field, double wallMm) {
+    std::vector<uint32_t> unplaced;
+    for (size_t p = 0; p < out.plan.holeOfPiece.size(); ++p)
+        if (out.plan.holeOfPiece[p] < 0) unplaced.push_back(uint32_t(p));
+    if (unplaced.size() < kMinCrossingLining) return 0;
+    // A gap narrower than two walls is a crack between parts, not a tunnel a piece lines; a voxel
+    // within a wall and two voxels of a core's edge is in the lining (or round a mouth).
+    const CrossingTunnels tunnels =
+        crossingTunnels(field, out.pieces.size(), 2.0 * wallMm, wallMm + 2.0 * field.voxelMm);
+    size_t lining = 0;
+    const std::string note = crossingTunnelNote(tunnels, unplaced, kMinCrossingLining, &lining);
+    if (note.empty()) return 0;
+    out.plan.problems.insert(out.plan.problems.begin(), note);
+    out.crossingTunnelPieces = lining;
+    return lining;
 }
 
 }  // namespace zomefab::pieces::detail

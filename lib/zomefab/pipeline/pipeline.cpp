@@ -139,6 +139,8 @@ constexpr double kReplanTiltDeg = 35.0;
 /// perpendicular kReplanTiltDeg when the user allowed more: a wider tilt gives more pieces pegs
 /// along more directions, and at 550 mm the armadillo's pieces then chose directions that lock
 /// each other at every margin tried (2, 5, 8, 11 mm), while at 35° a 5 mm margin put them on.
+/// Not when most pieces placed nowhere line tunnels that cross (NotBuildable::isInTheObject): other
+/// cuts leave those tunnels as they are (the cheese at 700 mm: three partitions, each as stuck).
 void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunContext& context,
                      const sdf::InteriorField& interior) {
     int refits = 0, replans = 0;
@@ -161,6 +163,7 @@ void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunConte
                                                std::to_string(run.frame.structure.strutCount()) +
                                                " struts: too few to hold every piece)",
                                            e.problemCount());
+            if (e.isInTheObject()) throw;  // tunnels that cross: other cuts do not free their linings
             if (!shouldPartitionAgain(replans, problemsBefore, e.problemCount())) {
                 if (replans >= kMaxReplans) throw;
                 throw pieces::NotBuildable(
