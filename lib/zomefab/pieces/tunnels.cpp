@@ -234,8 +234,9 @@ std::string crossingTunnelNote(const CrossingTunnels& tunnels, const std::vector
            std::to_string(tunnels.tunnels) + " straight tunnels about " +
            formatNumbers("%.0f", tunnels.meanDiameterMm) + " mm across, " +
            std::to_string(tunnels.crossings) + (tunnels.crossings == 1 ? " pair" : " pairs") +
-           " of them crossing): such a piece can reach its place only along its tunnel, past the crossings, "
-           "and zomefab cuts a lining into rings that slide in along their tunnel only where no other "
+           " of them crossing): such a piece can reach its place only through the "
+           "tunnels, and zomefab cuts a lining into rings that slide in along their tunnel only where no "
+           "other "
            "tunnel crosses it (docs/mounting.md, \"What is not done\"), so partitioning again does "
            "not help";
 }
