@@ -6,7 +6,6 @@
 #include <cmath>
 #include <deque>
 #include <iterator>
-#include <limits>
 
 #include "zomefab/core/format.h"
 
@@ -85,21 +84,17 @@ AxisShadow emptyShadow(int axis, const Coord& lo, const Coord& hi) {
 }
 
 void markHit(AxisShadow& shadow, const Coord& ijk) {
-    const int u = ijk[(shadow.axis + 1) % 3] - shadow.loU, v = ijk[(shadow.axis + 2) % 3] - shadow.loV;
-    if (u >= 0 && v >= 0 && u < shadow.sizeU && v < shadow.sizeV)
-        shadow.isHit[size_t(u) * size_t(shadow.sizeV) + size_t(v)] = 1;
+    const auto [u, v] = shadow.columnOf(ijk);
+    shadow.mark(u, v);
 }
 
 std::array<AxisShadow, 3> shadowsOf(const VoxelField& field) {
-    Coord lo(std::numeric_limits<int>::max()), hi(std::numeric_limits<int>::min());
-    bool any = false;
-    for (size_t s = 0; s < field.isActive.size(); ++s) {
-        if (!field.isInside(s)) continue;
-        const Coord c = field.coordOf(s);
-        lo.minComponent(c), hi.maxComponent(c), any = true;
-    }
     std::array<AxisShadow, 3> out;
-    if (!any) return out;
+    if (field.leafOrigin.empty()) return out;
+    // Over the leaves' bounds (a few voxels more than the inside's: columns no voxel hits).
+    Coord lo = field.leafOrigin[0], hi = field.leafOrigin[0];
+    for (const Coord& o : field.leafOrigin) lo.minComponent(o), hi.maxComponent(o);
+    hi.offset(7);
     for (int a = 0; a < 3; ++a) out[size_t(a)] = emptyShadow(a, lo, hi);
     for (size_t s = 0; s < field.isActive.size(); ++s)
         if (field.isInside(s))
@@ -190,18 +185,13 @@ CrossingTunnels crossingTunnels(const VoxelField& field, size_t pieceCount, doub
         out.meanDiameterMm += cores[i].diameterMm;
         const AxisShadow& hit = shadows[size_t(cores[i].axis)];
         AxisShadow& mark = near[size_t(cores[i].axis)];
-        const int u = (cores[i].axis + 1) % 3, v = (cores[i].axis + 2) % 3;
         for (const auto& [cu, cv] : cores[i].columns) {
             if (!hit.isHitAt(cu + 1, cv) && !hit.isHitAt(cu - 1, cv) && !hit.isHitAt(cu, cv + 1) &&
                 !hit.isHitAt(cu, cv - 1))
                 continue;
             for (int du = -r; du <= r; ++du)
                 for (int dv = -r; dv <= r; ++dv)
-                    if (du * du + dv * dv <= r * r) {
-                        Coord c(0, 0, 0);
-                        c[u] = cu + du, c[v] = cv + dv;
-                        markHit(mark, c);
-                    }
+                    if (du * du + dv * dv <= r * r) mark.mark(cu + du, cv + dv);
         }
     }
     if (out.tunnels == 0) return out;
@@ -211,9 +201,10 @@ CrossingTunnels crossingTunnels(const VoxelField& field, size_t pieceCount, doub
         if (!field.isInside(s) || field.owner[s] >= pieceCount) continue;
         const Coord c = field.coordOf(s);
         ++total[field.owner[s]];
-        const int a[3] = {c[1], c[2], c[0]}, b[3] = {c[2], c[0], c[1]};  // (u, v) along x, y, z
-        bool isNear = false;
-        for (int k = 0; k < 3 && !isNear; ++k) isNear = near[size_t(k)].isHitAt(a[k], b[k]);
+        const bool isNear = std::any_of(near.begin(), near.end(), [&](const AxisShadow& n) {
+            const auto [u, v] = n.columnOf(c);
+            return n.isHitAt(u, v);
+        });
         lining[field.owner[s]] += isNear ? 1 : 0;
     }
     for (size_t p = 0; p < pieceCount; ++p)
@@ -234,9 +225,8 @@ std::string crossingTunnelNote(const CrossingTunnels& tunnels, const std::vector
            std::to_string(tunnels.tunnels) + " straight tunnels about " +
            formatNumbers("%.0f", tunnels.meanDiameterMm) + " mm across, " +
            std::to_string(tunnels.crossings) + (tunnels.crossings == 1 ? " pair" : " pairs") +
-           " of them crossing): such a piece can reach its place only through the "
-           "tunnels, and zomefab cuts a lining into rings that slide in along their tunnel only where no "
-           "other "
+           " of them crossing): such a piece can reach its place only through the tunnels, and "
+           "zomefab cuts a lining into rings that slide in along their tunnel only where no other "
            "tunnel crosses it (docs/mounting.md, \"What is not done\"), so partitioning again does "
            "not help";
 }

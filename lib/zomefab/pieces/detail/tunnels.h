@@ -9,6 +9,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -51,9 +52,20 @@ struct AxisShadow {
     int sizeU = 0, sizeV = 0;    ///< columns across; one more than the voxels on every side
     std::vector<uint8_t> isHit;  ///< sizeU · sizeV, u major: the column meets the object
 
-    bool isHitAt(int u, int v) const {
+    /// The column (u, v) voxel @p ijk lies in.
+    std::array<int, 2> columnOf(const Coord& ijk) const { return {ijk[(axis + 1) % 3], ijk[(axis + 2) % 3]}; }
+    /// Where column (u, v) is kept in isHit; SIZE_MAX off the shadow.
+    size_t slotOf(int u, int v) const {
         u -= loU, v -= loV;
-        return u >= 0 && v >= 0 && u < sizeU && v < sizeV && isHit[size_t(u) * size_t(sizeV) + size_t(v)];
+        return u >= 0 && v >= 0 && u < sizeU && v < sizeV ? size_t(u) * size_t(sizeV) + size_t(v) : SIZE_MAX;
+    }
+    bool isHitAt(int u, int v) const {
+        const size_t k = slotOf(u, v);
+        return k != SIZE_MAX && isHit[k];
+    }
+    /// Marks column (u, v) as meeting the object (nothing off the shadow).
+    void mark(int u, int v) {
+        if (const size_t k = slotOf(u, v); k != SIZE_MAX) isHit[k] = 1;
     }
 };
 
