@@ -3,6 +3,7 @@
 
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <string>
 
 #include "frame_fixtures.h"
@@ -83,6 +84,23 @@ TEST_CASE("lattice: an object too thin for one ball fails with the sizes involve
         CHECK(m.find("needs 31.7 mm") != std::string::npos);                    // 24.85 + 47.3·√3/12
         CHECK(m.find("scaled up 1.58 times") != std::string::npos);
     }
+}
+
+TEST_CASE("lattice: a sphere as deep as cubeDepthMm holds a whole cube") {
+    // The worst case of the bound: a sphere is as deep as cubeDepthMm only at its centre. dMin 16 +
+    // radius 8.85, half a cube's diagonal 47.3·√3/2, half an offset step's diagonal 47.3·√3/12.
+    frame::LatticeOptions o;
+    const double depthMm = frame::cubeDepthMm(o);
+    CHECK(frame::ballDepthMm(o) == doctest::Approx(24.85));
+    CHECK(depthMm == doctest::Approx(24.85 + 47.3 * std::sqrt(3.0) * (0.5 + 1.0 / 12.0)));
+    // 2 mm voxels: the field's depth may be off by a voxel, so the sphere is 2 mm deeper.
+    const frame::LatticeResult r =
+        frame::initialLattice(test::sphereField(2.0 * (depthMm + 2.0)), o, RunContext::silent());
+    CHECK(r.cubes >= 1);
+    // Only a sufficient depth: a cube's own half diagonal is what a sphere needs at the least, so
+    // a sphere much shallower than cubeDepthMm holds none.
+    const double tooShallowMm = frame::ballDepthMm(o) + 0.5 * std::sqrt(3.0) * 47.3 - 2.0;
+    CHECK(frame::initialLattice(test::sphereField(2.0 * tooShallowMm), o, RunContext::silent()).cubes == 0);
 }
 
 TEST_CASE("lattice: bad options are usage errors") {

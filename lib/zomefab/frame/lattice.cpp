@@ -213,7 +213,21 @@ Placement evaluate(const FrameField& ff, double rotationDeg, const Vec3d& offset
     return pl;
 }
 
+/// Half the diagonal of one offset step (b0 / offsetSteps along each axis): every point lies within
+/// it of a lattice point of some placement tried (mm).
+double offsetStepDiagonalMm(const LatticeOptions& options) {
+    return 0.5 * std::sqrt(3.0) * options.scale.b0Mm / double(options.offsetSteps);
+}
+
 }  // namespace
+
+double ballDepthMm(const LatticeOptions& options) {
+    return options.zone.dMinMm + options.scale.ballRadiusMm();
+}
+
+double cubeDepthMm(const LatticeOptions& options) {
+    return ballDepthMm(options) + 0.5 * std::sqrt(3.0) * options.scale.b0Mm + offsetStepDiagonalMm(options);
+}
 
 LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptions& options,
                              RunContext& context) {
@@ -266,11 +280,11 @@ LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptio
     }
     if (cubes[best] == 0 && strutFrameBalls[best] == 0) {
         const double deepest = deepestDepthMm(field);
-        const double need = options.zone.dMinMm + options.scale.ballRadiusMm();
+        const double need = ballDepthMm(options);
         // The lattice points of the placements tried lie within half an offset step's diagonal of
         // any point, so a ball lands deep enough when the deepest point is that much deeper still;
         // every placement failed, and the deepest point says by how much the object falls short.
-        const double stepDiagonal = 0.5 * std::sqrt(3.0) * b0 / double(steps);
+        const double stepDiagonal = offsetStepDiagonalMm(options);
         const double wanted = need + stepDiagonal;
         std::string hint;
         if (deepest > 0 && deepest < wanted)

@@ -6,6 +6,8 @@
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
 #include "zomefab/core/version.h"
+#include "zomefab/frame/frame.h"
+#include "zomefab/frame/frame_field.h"
 #include "zomefab/frame/outermost.h"
 #include "zomefab/frame/reach.h"
 #include "zomefab/pieces/pieces.h"
@@ -127,6 +129,25 @@ constexpr size_t kReplanProblemRise = 5;
 /// The largest tenon tilt of those runs (degrees; pieces::TenonOptions::maxTiltDeg, default 60).
 constexpr double kReplanTiltDeg = 35.0;
 
+/// Why a frame with no whole B0 cube (a row or a square of balls) holds too few pieces, and how much
+/// larger the object would hold a cube for sure (frame::cubeDepthMm against its deepest point).
+std::string thinFrameReason(const report::RunRecord& run, const RunOptions& options,
+                            const sdf::InteriorField& interior) {
+    const double deepestMm = frame::deepestDepthMm(interior);
+    const double cubeMm =
+        frame::cubeDepthMm(frame::latticeOptionsFor(run.fabrication, options.frame.lattice));
+    std::string depth;
+    if (deepestMm > 0 && deepestMm < cubeMm)
+        depth = formatNumbers(": its deepest point is %.1f mm inside, and a cube there needs %.1f mm",
+                              deepestMm, cubeMm) +
+                formatNumbers(" (the object scaled up %.2f times, --height-mm, holds one for sure)",
+                              cubeMm / deepestMm);
+    return "the object is thinner than one B0 cube and its " +
+           formatNumbers("%.0f", run.fabrication.frameDMinMm()) + " mm clearance" + depth +
+           ", so its frame is only " + std::to_string(run.frame.structure.ballCount()) + " balls and " +
+           std::to_string(run.frame.structure.strutCount()) + " struts, too few to hold every piece";
+}
+
 /// Stages 5 and 6. A piece is its region of the surface plus the wall, the tenons and the pegs
 /// inside it; now and then (seen at 700 mm: 3.1 mm) that is larger than the region the partition
 /// fitted to the printer. The partition then runs again with its fit margin grown by the overshoot
@@ -153,15 +174,9 @@ void partitionAndCut(report::RunRecord& run, const RunOptions& options, RunConte
             return;
         } catch (const pieces::NotBuildable& e) {
             // A frame of a few balls in a row (no B0 cube fits) reaches little of a large surface:
-            // say that this, not the plan, is why.
+            // say first that this, not the plan, is why.
             if (run.frame.lattice.cubes == 0)
-                throw pieces::NotBuildable(e.message() + " (the object is thinner than one B0 cube and its " +
-                                               formatNumbers("%.0f", run.fabrication.frameDMinMm()) +
-                                               " mm clearance, so its frame is only " +
-                                               std::to_string(run.frame.structure.ballCount()) +
-                                               " balls and " +
-                                               std::to_string(run.frame.structure.strutCount()) +
-                                               " struts: too few to hold every piece)",
+                throw pieces::NotBuildable(thinFrameReason(run, options, interior) + "; " + e.message(),
                                            e.problemCount());
             if (e.isInTheObject()) throw;  // tunnels that cross: other cuts do not free their linings
             if (!shouldPartitionAgain(replans, problemsBefore, e.problemCount())) {
