@@ -168,7 +168,9 @@ void planTenonsToFit(Pieces& out, VoxelField& field, const GridCells& cells, Gro
     for (int round = 0;; ++round) {
         planPieces(out, field, cells, grouping, shell, frame, frameToGridMm, fabrication, out.options,
                    canGrow, context);
-        if (round == kFitRounds) return;
+        // A plan stuck on tunnels that cross is refused whatever the cuts (the cheese at 700 mm
+        // planned a second time, 5 minutes, for the same 257 stuck linings).
+        if (round == kFitRounds || out.crossingTunnelPieces > 0) return;
         const size_t cuts =
             splitOverPrinter(out.pieces, grouping, field, cells, out.options.tenons, fabrication.pieceBoxMm(),
                              fabrication.fitMarginMm, out.options.minPieceVolumeMm3, context);
