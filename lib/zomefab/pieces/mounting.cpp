@@ -80,7 +80,7 @@ bool FrameSweeps::isFree(const MountBody& body, int hole, double voxelMm, std::s
         moving.addPoint(madd(body.voxels[i], -half, d), 0.0, uint32_t(i));
     const mount::SweepHit hit = mount::worstHit(obstacles, moving, 0.0);
     if (hit.isHit && blockedBy)
-        *blockedBy = obstacleName(hit.obstacle) + " by " + formatNumber(hit.overlapMm, 2) + " mm";
+        *blockedBy = obstacleName(hit.obstacle) + " by " + formatNumber(hit.overlapMm, 3) + " mm";
     return !hit.isHit;
 }
 
