@@ -91,7 +91,7 @@ TEST_CASE("lattice: a sphere as deep as cubeDepthMm holds a whole cube") {
     // radius 8.85, half a cube's diagonal 47.3·√3/2, half an offset step's diagonal 47.3·√3/12.
     frame::LatticeOptions o;
     const double depthMm = frame::cubeDepthMm(o);
-    CHECK(frame::ballDepthMm(o) == doctest::Approx(24.85));
+    CHECK(frame::ballDepthLimitMm(o.zone, o.scale) == doctest::Approx(24.85));
     CHECK(depthMm == doctest::Approx(24.85 + 47.3 * std::sqrt(3.0) * (0.5 + 1.0 / 12.0)));
     // 2 mm voxels: the field's depth may be off by a voxel, so the sphere is 2 mm deeper.
     const frame::LatticeResult r =
@@ -99,7 +99,7 @@ TEST_CASE("lattice: a sphere as deep as cubeDepthMm holds a whole cube") {
     CHECK(r.cubes >= 1);
     // Only a sufficient depth: a cube's own half diagonal is what a sphere needs at the least, so
     // a sphere much shallower than cubeDepthMm holds none.
-    const double tooShallowMm = frame::ballDepthMm(o) + 0.5 * std::sqrt(3.0) * 47.3 - 2.0;
+    const double tooShallowMm = frame::ballDepthLimitMm(o.zone, o.scale) + 0.5 * std::sqrt(3.0) * 47.3 - 2.0;
     CHECK(frame::initialLattice(test::sphereField(2.0 * tooShallowMm), o, RunContext::silent()).cubes == 0);
 }
 

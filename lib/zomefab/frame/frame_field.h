@@ -17,6 +17,12 @@ namespace zomefab::frame {
 /// Rotation about +z by @p degrees as a transform (x ↦ R·x).
 Transform4d rotationAboutZ(double degrees);
 
+/// Smallest depth inside the surface a ball's centre may have: the clearance dMin and the ball's
+/// radius (mm). The one rule, for a FrameField and for the lattice's depth bounds (cubeDepthMm).
+inline double ballDepthLimitMm(const sdf::ForbiddenZoneOptions& zone, const zome::ZomeScale& scale) {
+    return zone.dMinMm + scale.ballRadiusMm();
+}
+
 /// The interior field seen from the frame's coordinates, plus the clearance rules. The frame's
 /// millimetres are the field's millimetres rotated by −rotationDeg about z: a point p of the frame
 /// lies at R(rotationDeg)·p in the field. Read-only after construction: safe for any number of
@@ -42,8 +48,8 @@ public:
     /// Distance of @p frameMm inside the surface (negative outside), mm.
     double depthMm(const Vec3d& frameMm) const { return mField->depthMm(toFieldMm(frameMm)); }
 
-    /// Smallest centre depth a ball may have: dMin + ball radius.
-    double ballDepthLimitMm() const { return mZone.dMinMm + mScale.ballRadiusMm(); }
+    /// Smallest centre depth a ball may have: dMin + ball radius (frame::ballDepthLimitMm).
+    double ballDepthLimitMm() const { return frame::ballDepthLimitMm(mZone, mScale); }
     /// Smallest depth the axis of a strut of @p color may have: dMin + strut radius.
     double strutDepthLimitMm(zome::Color color) const {
         return mZone.dMinMm + mScale.strutRadiusMm(color);

@@ -221,12 +221,9 @@ double offsetStepDiagonalMm(const LatticeOptions& options) {
 
 }  // namespace
 
-double ballDepthMm(const LatticeOptions& options) {
-    return options.zone.dMinMm + options.scale.ballRadiusMm();
-}
-
 double cubeDepthMm(const LatticeOptions& options) {
-    return ballDepthMm(options) + 0.5 * std::sqrt(3.0) * options.scale.b0Mm + offsetStepDiagonalMm(options);
+    return ballDepthLimitMm(options.zone, options.scale) + 0.5 * std::sqrt(3.0) * options.scale.b0Mm +
+           offsetStepDiagonalMm(options);
 }
 
 LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptions& options,
@@ -280,7 +277,7 @@ LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptio
     }
     if (cubes[best] == 0 && strutFrameBalls[best] == 0) {
         const double deepest = deepestDepthMm(field);
-        const double need = ballDepthMm(options);
+        const double need = ballDepthLimitMm(options.zone, options.scale);
         // The lattice points of the placements tried lie within half an offset step's diagonal of
         // any point, so a ball lands deep enough when the deepest point is that much deeper still;
         // every placement failed, and the deepest point says by how much the object falls short.

@@ -46,12 +46,9 @@ struct LatticeResult {
 LatticeResult initialLattice(const sdf::InteriorField& field, const LatticeOptions& options,
                              RunContext& context);
 
-/// How far inside the surface a ball's centre must lie: the clearance dMin and the ball's radius (mm).
-double ballDepthMm(const LatticeOptions& options);
-
 /// How far inside the surface (mm) a point must lie for the offset search to find a whole B0 cube
-/// there for sure: a ball's depth (ballDepthMm), half a cube's diagonal (its corners round its
-/// centre) and half an offset step's diagonal (some placement puts a cube's centre that close to
+/// there for sure: a ball's depth (ballDepthLimitMm, frame_field.h), half a cube's diagonal (its corners
+/// round its centre) and half an offset step's diagonal (some placement puts a cube's centre that close to
 /// any point). Depth falls by at most the distance moved, so every ball and strut of that cube
 /// keeps dMin. A sufficient depth, not a necessary one: a luckier point may hold a cube less deep.
 double cubeDepthMm(const LatticeOptions& options);

@@ -105,16 +105,18 @@ std::array<AxisShadow, 3> shadowsOf(const VoxelField& field) {
 std::vector<TunnelCore> tunnelCores(const AxisShadow& shadow, double voxelMm, double minDiameterMm) {
     std::vector<TunnelCore> out;
     const int nu = shadow.sizeU, nv = shadow.sizeV;
-    std::vector<uint8_t> isSeen(shadow.isHit);  // hit columns count as seen
+    // Indexed as isHit (AxisShadow::slotOf without the offsets): hit columns count as seen.
+    std::vector<uint8_t> isSeen(shadow.isHit);
+    auto seen = [&](int u, int v) -> uint8_t& { return isSeen[size_t(u) * size_t(nv) + size_t(v)]; };
     for (int u0 = 0; u0 < nu; ++u0)
         for (int v0 = 0; v0 < nv; ++v0) {
-            if (isSeen[size_t(u0) * size_t(nv) + size_t(v0)]) continue;
+            if (seen(u0, v0)) continue;
             // One connected set of free columns (4-neighbours), flood-filled.
             TunnelCore core;
             core.axis = shadow.axis;
             bool isOpen = false;  // reaches the border: the lines round the object
             std::deque<std::array<int, 2>> queue{{u0, v0}};
-            isSeen[size_t(u0) * size_t(nv) + size_t(v0)] = 1;
+            seen(u0, v0) = 1;
             while (!queue.empty()) {
                 const auto [u, v] = queue.front();
                 queue.pop_front();
@@ -123,9 +125,8 @@ std::vector<TunnelCore> tunnelCores(const AxisShadow& shadow, double voxelMm, do
                 const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
                 for (int k = 0; k < 4; ++k) {
                     const int a = u + du[k], b = v + dv[k];
-                    if (a < 0 || b < 0 || a >= nu || b >= nv || isSeen[size_t(a) * size_t(nv) + size_t(b)])
-                        continue;
-                    isSeen[size_t(a) * size_t(nv) + size_t(b)] = 1;
+                    if (a < 0 || b < 0 || a >= nu || b >= nv || seen(a, b)) continue;
+                    seen(a, b) = 1;
                     queue.push_back({a, b});
                 }
             }
