@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "tunnel_fixtures.h"
+
 using namespace zomefab;
 using namespace zomefab::pieces::detail;
 
@@ -73,36 +75,6 @@ TEST_CASE(
     CHECK(std::abs(groups[0].axis[0]) > 0.99);
     CHECK(groups[0].pieces == std::vector<uint32_t>{0, 1});
 }
-
-namespace {
-
-/// A solid cube [0, n)³ of 1 mm voxels as a shell field (every voxel inside), less round tunnels of
-/// radius @p r through its middle along each axis in @p axes; voxels within @p liningMm of a tunnel's
-/// wall are owned by piece 0, the rest by piece 1.
-VoxelField cubeWithTunnels(int n, double r, const std::vector<int>& axes, double liningMm) {
-    FloatGrid::Ptr grid = FloatGrid::create(3.0f);
-    FloatGrid::Accessor acc = grid->getAccessor();
-    const double c = 0.5 * (n - 1);
-    auto wallDistance = [&](const Coord& ijk) {  // to the nearest tunnel's wall, negative inside it
-        double d = 1e9;
-        for (int a : axes) {
-            const double u = ijk[(a + 1) % 3] - c, v = ijk[(a + 2) % 3] - c;
-            d = std::min(d, std::sqrt(u * u + v * v) - r);
-        }
-        return d;
-    };
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j)
-            for (int k = 0; k < n; ++k)
-                if (wallDistance(Coord(i, j, k)) > 0.0) acc.setValue(Coord(i, j, k), -1.0f);
-    VoxelField field = buildField(*grid);
-    field.owner.assign(field.phi.size(), kNone);
-    for (size_t s = 0; s < field.phi.size(); ++s)
-        if (field.isInside(s)) field.owner[s] = wallDistance(field.coordOf(s)) <= liningMm ? 0 : 1;
-    return field;
-}
-
-}  // namespace
 
 TEST_CASE("tunnelCores: the free lines enclosed by the object, not those round it, and none too narrow") {
     AxisShadow shadow = emptyShadow(0, Coord(0, 0, 0), Coord(40, 40, 40));

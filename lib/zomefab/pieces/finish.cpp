@@ -16,7 +16,7 @@ namespace {
 std::vector<CutFace> cutPlanes(const GridCells& cells, const CellSet& set, double seamGapMm) {
     const size_t cellCount = cells.count();
     std::vector<CutFace> planes;
-    for (uint32_t k : set.members)
+    for (uint32_t k : set.isLining ? std::vector<uint32_t>() : set.members)
         for (uint32_t j = 0; j < cellCount; ++j) {
             if (set.isMember[j]) continue;
             const double inv = cells.invNorm[k * cellCount + j];

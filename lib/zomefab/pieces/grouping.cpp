@@ -277,7 +277,9 @@ FaceContacts faceContacts(const VoxelField& field, const GridCells& cells, const
         Vec3d normal{0, 0, 0};
         // Two cells of one piece's region are not cut from each other: where each piece has both
         // cells, the pair lies across a plane they were re-cut along.
-        const bool isCellPlane = ca != cb && !(sets[pa].isMember[cb] && sets[pb].isMember[ca]);
+        // A lining carved along a tunnel (detail/prisms.h) is bounded by its prism, not by cells.
+        const bool isLining = sets[pa].isLining || sets[pb].isLining;
+        const bool isCellPlane = !isLining && ca != cb && !(sets[pa].isMember[cb] && sets[pb].isMember[ca]);
         if (isCellPlane) {
             normal = normalized(sub(cells.w[cb], cells.w[ca]));  // the plane s_ca = s_cb, into cb
         } else {

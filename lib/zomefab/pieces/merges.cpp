@@ -32,7 +32,8 @@ std::vector<std::vector<size_t>> insideSlots(const VoxelField& field, const std:
 }  // namespace
 
 bool isMergeable(const std::vector<CellSet>& sets, uint32_t a, uint32_t b) {
-    return a != b && sets[a].halfSpaces.empty() && sets[b].halfSpaces.empty();
+    return a != b && sets[a].halfSpaces.empty() && sets[b].halfSpaces.empty() && !sets[a].isLining &&
+           !sets[b].isLining;
 }
 
 std::optional<size_t> splitPlaneBetween(const std::vector<CellSet>& sets, uint32_t a, uint32_t b) {

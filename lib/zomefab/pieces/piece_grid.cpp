@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "zomefab/pieces/detail/pins.h"
+#include "zomefab/pieces/detail/prisms.h"
 #include "zomefab/pieces/detail/stages.h"
 #include "zomefab/sdf/level_set.h"
 
@@ -19,6 +20,10 @@ namespace {
 double pieceRegionDistance(const GridCells& cells, const CellSet& set, const Vec3d& x, double* scores) {
     double d = regionDistance(cells, set, x, scores);
     for (const CellSet::HalfSpace& h : set.halfSpaces) d = std::max(d, dot(h.normal, x) - h.offsetMm);
+    for (const CellSet::PrismBound& b : set.prisms) {
+        const double e = b.prism->signedDistanceMm(x);
+        d = std::max(d, b.isInside ? e : -e);
+    }
     return d;
 }
 

@@ -32,7 +32,7 @@ struct FacePlane {
 /// The cells' plane between two voxels of a and b, or the re-cut plane when they share a cell.
 std::optional<FacePlane> planeBetween(const GridCells& cells, const std::vector<CellSet>& sets, uint32_t a,
                                       uint32_t b, uint32_t ca, uint32_t cb) {
-    if (ca != cb) {
+    if (ca != cb && !sets[a].isLining && !sets[b].isLining) {
         const Vec3d w = sub(cells.w[cb], cells.w[ca]);
         const double len = norm(w);
         if (len == 0) return std::nullopt;

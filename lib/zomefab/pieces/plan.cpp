@@ -15,6 +15,7 @@
 #include "zomefab/pieces/detail/merges.h"
 #include "zomefab/pieces/detail/mounting.h"
 #include "zomefab/pieces/detail/pins.h"
+#include "zomefab/pieces/detail/prisms.h"
 #include "zomefab/pieces/detail/replan.h"
 #include "zomefab/pieces/detail/splits.h"
 #include "zomefab/pieces/detail/stages.h"
@@ -56,10 +57,6 @@ constexpr int kKeystoneRounds = 3;
 /// Keystones are tried only while at most this many pieces are placed nowhere: three rings of up to
 /// eight pieces (the torus of docs/mounting.md: 7).
 constexpr size_t kMaxKeystoneStuck = 24;
-/// Tunnel linings are cut into slabs this long along the tunnel (mm): short enough that the seams
-/// the partition left along the tunnel seldom zigzag within one slab, long enough not to double the
-/// pieces of a lining 200 mm long.
-constexpr double kTunnelSlabMm = 80.0;
 /// Tunnel linings are cut only while at most this many pieces are placed nowhere: a few tunnels'
 /// linings (the 300 mm cube's: 19 pieces), not the cheese's hundreds (docs/benchmarks.md, "Tunnels").
 constexpr size_t kMaxTunnelStuck = 100;
@@ -457,6 +454,13 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         // (the cheese at 700 mm: cavity linings taken for tunnels, nothing freed, each plan minutes).
         context.debug("mounting: " + std::to_string(unplaced) + " pieces placed nowhere by plan " +
                       std::to_string(round));
+        // Most pieces placed nowhere line tunnels that cross (two at a time): their linings carved
+        // along their prisms, as rings.
+        if (round == 0 && crossingTunnelLining(out, field, fabrication.wallMm, nullptr) > 0 &&
+            carveCrossingLinings(out.pieces, grouping, field, cells, fabrication.wallMm,
+                                 fabrication.frameDMinMm(), splitSearchFor(field, opt).minVolumeMm3,
+                                 context) > 0)
+            continue;
         if (round == 0 && unplaced <= kMaxTunnelStuck &&
             cutTunnelLinings(out, field, cells, grouping, input, sweeps, opt, context) > 0)
             continue;

@@ -161,20 +161,32 @@ bool coresCross(const TunnelCore& a, const TunnelCore& b) {
     return !both.empty();
 }
 
+std::vector<TunnelCore> coresAlongAxes(const std::array<AxisShadow, 3>& shadows, double voxelMm,
+                                       double minDiameterMm) {
+    std::vector<TunnelCore> cores;
+    for (const AxisShadow& s : shadows)
+        for (TunnelCore& core : tunnelCores(s, voxelMm, minDiameterMm)) cores.push_back(std::move(core));
+    return cores;
+}
+
+std::vector<uint8_t> crossingFlags(const std::vector<TunnelCore>& cores, size_t* pairs) {
+    std::vector<uint8_t> crosses(cores.size(), 0);
+    size_t count = 0;
+    for (size_t i = 0; i < cores.size(); ++i)
+        for (size_t j = i + 1; j < cores.size(); ++j)
+            if (coresCross(cores[i], cores[j])) crosses[i] = crosses[j] = 1, ++count;
+    if (pairs) *pairs = count;
+    return crosses;
+}
+
 CrossingTunnels crossingTunnels(const VoxelField& field, size_t pieceCount, double minDiameterMm,
                                 double reachMm) {
     CrossingTunnels out;
     out.liningShare.assign(pieceCount, 0.0);
     std::array<AxisShadow, 3> shadows = shadowsOf(field);
     if (shadows[0].isHit.empty()) return out;
-    std::vector<TunnelCore> cores;
-    for (const AxisShadow& s : shadows)
-        for (TunnelCore& core : tunnelCores(s, field.voxelMm, minDiameterMm))
-            cores.push_back(std::move(core));
-    std::vector<uint8_t> crosses(cores.size(), 0);
-    for (size_t i = 0; i < cores.size(); ++i)
-        for (size_t j = i + 1; j < cores.size(); ++j)
-            if (coresCross(cores[i], cores[j])) crosses[i] = crosses[j] = 1, ++out.crossings;
+    const std::vector<TunnelCore> cores = coresAlongAxes(shadows, field.voxelMm, minDiameterMm);
+    const std::vector<uint8_t> crosses = crossingFlags(cores, &out.crossings);
     // Near a crossing core: within reach of one of its columns across its axis (a disc stamped
     // round each column at the core's edge, next to a column the object hits).
     std::array<AxisShadow, 3> near = shadows;
@@ -227,12 +239,12 @@ std::string crossingTunnelNote(const CrossingTunnels& tunnels, const std::vector
            formatNumbers("%.0f", tunnels.meanDiameterMm) + " mm across, " +
            std::to_string(tunnels.crossings) + (tunnels.crossings == 1 ? " pair" : " pairs") +
            " of them crossing): such a piece can reach its place only through the tunnels, and "
-           "zomefab cuts a lining into rings that slide in along their tunnel only where no other "
-           "tunnel crosses it (docs/mounting.md, \"What is not done\"), so partitioning again does "
-           "not help";
+           "zomefab lines a tunnel with rings that slide in along it where no other tunnel crosses it "
+           "or where tunnels cross two at a time, not where three meet at one point (docs/mounting.md, "
+           "\"What is not done\"), so partitioning again does not help";
 }
 
-size_t noteCrossingTunnels(Pieces& out, const VoxelField& field, double wallMm) {
+size_t crossingTunnelLining(const Pieces& out, const VoxelField& field, double wallMm, std::string* note) {
     std::vector<uint32_t> unplaced;
     for (size_t p = 0; p < out.plan.holeOfPiece.size(); ++p)
         if (out.plan.holeOfPiece[p] < 0) unplaced.push_back(uint32_t(p));
@@ -242,8 +254,15 @@ size_t noteCrossingTunnels(Pieces& out, const VoxelField& field, double wallMm) 
     const CrossingTunnels tunnels =
         crossingTunnels(field, out.pieces.size(), 2.0 * wallMm, wallMm + 2.0 * field.voxelMm);
     size_t lining = 0;
-    const std::string note = crossingTunnelNote(tunnels, unplaced, kMinCrossingLining, &lining);
-    if (note.empty()) return 0;
+    const std::string text = crossingTunnelNote(tunnels, unplaced, kMinCrossingLining, &lining);
+    if (note) *note = text;
+    return text.empty() ? 0 : lining;
+}
+
+size_t noteCrossingTunnels(Pieces& out, const VoxelField& field, double wallMm) {
+    std::string note;
+    const size_t lining = crossingTunnelLining(out, field, wallMm, &note);
+    if (lining == 0) return 0;
     out.plan.problems.insert(out.plan.problems.begin(), note);
     out.crossingTunnelPieces = lining;
     return lining;

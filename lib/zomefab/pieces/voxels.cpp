@@ -32,6 +32,7 @@ GridCells toGridCells(const partition::LinearCells& model, const Transform4d& fr
 }
 
 double regionDistance(const GridCells& c, const CellSet& set, const Vec3d& x, double* scores) {
+    if (set.isLining) return -std::numeric_limits<double>::infinity();
     c.owner(x, scores);
     const size_t n = c.count();
     // min over member cells k of max over the cutting cells j of the signed distance to the plane

@@ -37,6 +37,11 @@ struct TunnelGroup {
 std::vector<TunnelGroup> tunnelGroups(const std::vector<uint32_t>& pieces,
                                       const std::vector<std::vector<Vec3d>>& freeAlong, size_t minPieces = 2);
 
+/// Tunnel linings are cut into slabs this long along the tunnel (mm): short enough that the seams
+/// the partition left along the tunnel seldom zigzag within one slab, long enough not to double the
+/// pieces of a lining 200 mm long.
+inline constexpr double kTunnelSlabMm = 80.0;
+
 /// Where to cut a piece whose voxel centres lie at @p t along the axis (mm) into slabs: at the
 /// multiples of @p slabMm inside its range, skipping a plane that would leave fewer than
 /// @p minVoxels on either side of it (counted between the planes kept). Ascending. The same
@@ -93,6 +98,13 @@ std::vector<TunnelCore> tunnelCores(const AxisShadow& shadow, double voxelMm, do
 /// along two axes meet where they share a value of the third axis (the one along neither).
 bool coresCross(const TunnelCore& a, const TunnelCore& b);
 
+/// The cores of @p shadows (x, y, then z) at least @p minDiameterMm across (tunnelCores).
+std::vector<TunnelCore> coresAlongAxes(const std::array<AxisShadow, 3>& shadows, double voxelMm,
+                                       double minDiameterMm);
+
+/// Per core: whether it crosses another (coresCross); @p pairs (optional): how many pairs cross.
+std::vector<uint8_t> crossingFlags(const std::vector<TunnelCore>& cores, size_t* pairs);
+
 /// The tunnels of an object that cross each other, and the pieces that line them.
 struct CrossingTunnels {
     size_t tunnels = 0;    ///< cores that cross at least one other
@@ -117,6 +129,11 @@ std::string crossingTunnelNote(const CrossingTunnels& tunnels, const std::vector
 
 /// The fewest pieces placed nowhere that noteCrossingTunnels puts down to crossing tunnels.
 inline constexpr size_t kMinCrossingLining = 4;
+
+/// After a plan that places pieces nowhere: how many of them line tunnels that cross (the shell's
+/// own cores at least two walls across, crossingTunnels), when most of them (and at least
+/// kMinCrossingLining) do, else 0; @p note (optional) receives what the plan then says.
+size_t crossingTunnelLining(const Pieces& out, const VoxelField& field, double wallMm, std::string* note);
 
 /// After a plan that places pieces nowhere: when most of them line tunnels that cross (the shell's
 /// own cores at least two walls across, crossingTunnels), says so as the plan's first problem and

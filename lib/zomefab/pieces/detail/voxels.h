@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <unordered_map>
 #include <vector>
 
@@ -25,6 +26,8 @@ using FloatLeaf = FloatTree::LeafNodeType;
 
 constexpr uint32_t kNone = 0xFFFFFFFFu;
 constexpr uint32_t kLeafSize = 512;  // 8³ voxels per leaf node
+
+struct TunnelPrism;  // detail/prisms.h
 
 /// The argmax cells mapped to grid mm, with 1/|w_i − w_j| for the plane distances.
 struct GridCells {
@@ -60,6 +63,15 @@ struct CellSet {
         double offsetMm = 0.0;
     };
     std::vector<HalfSpace> halfSpaces;
+    /// Tunnel prisms that bound it (detail/prisms.h): a lining carved along its tunnel lies inside
+    /// its own and outside those of earlier axes; every other piece lies outside all of them.
+    struct PrismBound {
+        std::shared_ptr<const TunnelPrism> prism;
+        bool isInside = false;
+    };
+    std::vector<PrismBound> prisms;
+    /// A lining carved along a prism: its cells do not bound it, only its prisms and half-spaces.
+    bool isLining = false;
 };
 
 /// δ_P: a signed distance to the region of the piece's cells (negative inside), from the planes

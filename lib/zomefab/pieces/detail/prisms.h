@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file The linings of two tunnels that cross, carved out of the partition's pieces (internal to
+/// lib/zomefab/pieces). The partition's pieces at a crossing hold parts of both linings and meet the
+/// frame along every direction. Each tunnel's lining is carved out along its prism instead (its core
+/// grown across its axis by a wall): a piece inside a prism slides along the tunnel past no ball
+/// and no strut. Where two prisms overlap the earlier axis (x, then y, then z) keeps the shell, so its
+/// lining runs through the crossing unbroken and goes on as glued rings, and the other tunnel's
+/// segments end against it with faces across their own axis, each glued onto a ring at its far
+/// end. Three tunnels through one point are not carved: there no lining at all crosses the
+/// crossing's middle, and glue alone cannot hold every segment (docs/mounting.md, "Tunnels that
+/// cross").
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "zomefab/core/run_context.h"
+#include "zomefab/core/vec.h"
+#include "zomefab/pieces/detail/grouping.h"
+#include "zomefab/pieces/detail/tunnels.h"
+#include "zomefab/pieces/detail/voxels.h"
+#include "zomefab/pieces/pieces.h"
+
+namespace zomefab::pieces::detail {
+
+/// A tunnel's prism: the straight lines within radiusMm of its core's lines (across its axis),
+/// between two planes across the axis. With a radius under the frame's clearance, a point of it lies
+/// closer to the surface than any ball or strut may (the nearest core line runs outside the
+/// object), so it holds only the lining's shell.
+struct TunnelPrism {
+    int axis = 0;
+    int loU = 0, loV = 0;      ///< the raster's first column (voxel indices along axis + 1, axis + 2)
+    int sizeU = 0, sizeV = 0;  ///< columns in the raster
+    std::vector<float> coreDistanceMm;  ///< per column (u major): to the nearest core column's centre
+    double radiusMm = 0.0;
+    double loMm = 0.0, hiMm = 0.0;  ///< its ends along the axis (grid mm)
+    double voxelMm = 1.0;
+    Vec3d originMm{0, 0, 0};  ///< grid mm of voxel index (0, 0, 0)
+
+    /// The core distance of column (u, v); a far value off the raster.
+    double columnDistanceMm(int u, int v) const;
+    /// Whether voxel @p ijk lies in the prism: its column within the radius, its centre between the ends.
+    bool contains(const Coord& ijk) const;
+    /// Signed distance to the prism at @p x (grid mm, negative inside): the core distance
+    /// interpolated between the four nearest columns less the radius, and the distances past the ends.
+    double signedDistanceMm(const Vec3d& x) const;
+};
+
+/// The prism of @p core (the columns of @p field's grid within @p radiusMm of its columns'
+/// centres), ends at @p loMm and @p hiMm along its axis.
+TunnelPrism tunnelPrism(const TunnelCore& core, const VoxelField& field, double radiusMm, double loMm,
+                        double hiMm);
+
+/// Which prism each slot of @p field lies in: of the prisms holding it, the one of the earliest axis
+/// (then the lowest index); kNone for none. Per slot, band included.
+std::vector<uint32_t> prismOwners(const VoxelField& field, const std::vector<TunnelPrism>& prisms);
+
+/// The prisms of the tunnels of @p field that cross (tunnelCores at least @p minDiameterMm across,
+/// coresCross), each @p radiusMm round its core and ending @p endMm inside the object's voxels along
+/// its lines (the mouth's own shell stays with the pieces round it). Empty when no two cross, or
+/// when three cross at one point (@p isTriple is then set).
+std::vector<TunnelPrism> crossingPrisms(const VoxelField& field, double minDiameterMm, double radiusMm,
+                                        double endMm, bool* isTriple);
+
+/// The linings of crossing tunnels carved out of the pieces (see the file's comment): every inside
+/// voxel of a prism goes to a new piece, one per connected part of the voxels a prism owns (parts
+/// under a cubic centimetre stay with their piece); pieces left with no voxels are dropped and the
+/// rest renumbered; each remaining piece's cell set keeps out of every prism, each new one keeps to
+/// its prism and out of the earlier axes' prisms; the band's owners follow. Then every lining is cut
+/// across its axis into rings at the multiples of kTunnelSlabMm (slabOffsets, parts of at least
+/// @p minPieceVolumeMm3) and the face contacts are made again. Prisms of radius @p wallMm plus a
+/// voxel, which must stay under @p frameDMinMm (else nothing is carved). Returns how many pieces
+/// line the tunnels (0: nothing changed).
+size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
+                            const GridCells& cells, double wallMm, double frameDMinMm,
+                            double minPieceVolumeMm3, const RunContext& context);
+
+}  // namespace zomefab::pieces::detail
