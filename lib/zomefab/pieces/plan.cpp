@@ -454,9 +454,9 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         // (the cheese at 700 mm: cavity linings taken for tunnels, nothing freed, each plan minutes).
         context.debug("mounting: " + std::to_string(unplaced) + " pieces placed nowhere by plan " +
                       std::to_string(round));
-        // Most pieces placed nowhere line tunnels that cross (two at a time): their linings carved
-        // along their prisms, as rings.
-        if (round == 0 && crossingTunnelLining(out, field, fabrication.wallMm, nullptr) > 0 &&
+        // Pieces placed nowhere line tunnels that cross (two at a time): their linings carved along
+        // their prisms, as rings.
+        if (round == 0 && crossingTunnelLining(out, field, fabrication.wallMm, nullptr, false) > 0 &&
             carveCrossingLinings(out.pieces, grouping, field, cells, fabrication.wallMm,
                                  fabrication.frameDMinMm(), splitSearchFor(field, opt).minVolumeMm3,
                                  context) > 0)

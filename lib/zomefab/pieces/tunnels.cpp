@@ -244,7 +244,8 @@ std::string crossingTunnelNote(const CrossingTunnels& tunnels, const std::vector
            "\"What is not done\"), so partitioning again does not help";
 }
 
-size_t crossingTunnelLining(const Pieces& out, const VoxelField& field, double wallMm, std::string* note) {
+size_t crossingTunnelLining(const Pieces& out, const VoxelField& field, double wallMm, std::string* note,
+                            bool isMostRequired) {
     std::vector<uint32_t> unplaced;
     for (size_t p = 0; p < out.plan.holeOfPiece.size(); ++p)
         if (out.plan.holeOfPiece[p] < 0) unplaced.push_back(uint32_t(p));
@@ -253,6 +254,11 @@ size_t crossingTunnelLining(const Pieces& out, const VoxelField& field, double w
     // within a wall and two voxels of a core's edge is in the lining (or round a mouth).
     const CrossingTunnels tunnels =
         crossingTunnels(field, out.pieces.size(), 2.0 * wallMm, wallMm + 2.0 * field.voxelMm);
+    if (!isMostRequired) {
+        const size_t lining = size_t(std::count_if(
+            unplaced.begin(), unplaced.end(), [&](uint32_t p) { return tunnels.liningShare[p] >= 0.5; }));
+        return lining >= kMinCrossingLining ? lining : 0;
+    }
     size_t lining = 0;
     const std::string text = crossingTunnelNote(tunnels, unplaced, kMinCrossingLining, &lining);
     if (note) *note = text;
@@ -261,7 +267,7 @@ size_t crossingTunnelLining(const Pieces& out, const VoxelField& field, double w
 
 size_t noteCrossingTunnels(Pieces& out, const VoxelField& field, double wallMm) {
     std::string note;
-    const size_t lining = crossingTunnelLining(out, field, wallMm, &note);
+    const size_t lining = crossingTunnelLining(out, field, wallMm, &note, true);
     if (lining == 0) return 0;
     out.plan.problems.insert(out.plan.problems.begin(), note);
     out.crossingTunnelPieces = lining;

@@ -130,10 +130,12 @@ std::string crossingTunnelNote(const CrossingTunnels& tunnels, const std::vector
 /// The fewest pieces placed nowhere that noteCrossingTunnels puts down to crossing tunnels.
 inline constexpr size_t kMinCrossingLining = 4;
 
-/// After a plan that places pieces nowhere: how many of them line tunnels that cross (the shell's
-/// own cores at least two walls across, crossingTunnels), when most of them (and at least
-/// kMinCrossingLining) do, else 0; @p note (optional) receives what the plan then says.
-size_t crossingTunnelLining(const Pieces& out, const VoxelField& field, double wallMm, std::string* note);
+/// After a plan that places pieces nowhere: how many of them line tunnels that cross (half their
+/// voxels or more near the shell's own cores at least two walls across, crossingTunnels), when at
+/// least kMinCrossingLining do and, with @p isMostRequired, most of them do; else 0. @p note
+/// (optional, with @p isMostRequired) receives what the plan then says.
+size_t crossingTunnelLining(const Pieces& out, const VoxelField& field, double wallMm, std::string* note,
+                            bool isMostRequired);
 
 /// After a plan that places pieces nowhere: when most of them line tunnels that cross (the shell's
 /// own cores at least two walls across, crossingTunnels), says so as the plan's first problem and
