@@ -34,12 +34,9 @@ struct PrismLookup {
 
 PrismLookup prismLookup(const VoxelField& field, const std::vector<TunnelPrism>& prisms) {
     PrismLookup out;
-    Coord lo = field.leafOrigin[0], hi = field.leafOrigin[0];
-    for (const Coord& o : field.leafOrigin) lo.minComponent(o), hi.maxComponent(o);
-    hi.offset(7);
+    out.columns = emptyShadowsOf(field);
     std::array<std::vector<float>, 3> best;
     for (int a = 0; a < 3; ++a) {
-        out.columns[size_t(a)] = emptyShadow(a, lo, hi);
         const size_t n = out.columns[size_t(a)].isHit.size();
         out.prism[size_t(a)].assign(n, kNone);
         best[size_t(a)].assign(n, std::numeric_limits<float>::infinity());
@@ -101,12 +98,13 @@ void ownBand(VoxelField& field, const std::vector<uint32_t>& prismOf, const std:
 }
 
 /// Drops the pieces no inside voxel belongs to and numbers the rest in order (ids, cell sets,
-/// voxel owners; band voxels of a dropped piece become unowned). Returns the new id of each old id.
-std::vector<uint32_t> dropEmptyPieces(std::vector<Piece>& pieces, std::vector<CellSet>& sets,
-                                      VoxelField& field) {
+/// voxel owners; band voxels of a dropped piece become unowned); every piece's shell volume counted
+/// anew. Returns how many were dropped.
+size_t dropEmptyPieces(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field) {
     std::vector<size_t> inside(pieces.size(), 0);
     for (size_t s = 0; s < field.owner.size(); ++s)
         if (field.isInside(s) && field.owner[s] < pieces.size()) ++inside[field.owner[s]];
+    const double voxelVolume = field.voxelMm * field.voxelMm * field.voxelMm;
     std::vector<uint32_t> newId(pieces.size(), kNone);
     std::vector<Piece> keptPieces;
     std::vector<CellSet> keptSets;
@@ -115,13 +113,15 @@ std::vector<uint32_t> dropEmptyPieces(std::vector<Piece>& pieces, std::vector<Ce
         newId[p] = uint32_t(keptPieces.size());
         keptPieces.push_back(std::move(pieces[p]));
         keptPieces.back().id = newId[p];
+        keptPieces.back().shellVolumeMm3 = double(inside[p]) * voxelVolume;
         keptSets.push_back(std::move(sets[p]));
     }
+    const size_t dropped = pieces.size() - keptPieces.size();
     pieces = std::move(keptPieces);
     sets = std::move(keptSets);
     for (uint32_t& o : field.owner)
         if (o != kNone) o = o < newId.size() ? newId[o] : kNone;
-    return newId;
+    return dropped;
 }
 
 }  // namespace
@@ -366,17 +366,10 @@ size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, Voxe
     // Band voxels in a prism belong to its lining; the pieces the carve emptied go.
     for (size_t s = 0; s < field.owner.size(); ++s)
         if (field.isActive[s] && !field.isInside(s) && prismOf[s] != kNone) field.owner[s] = kNone;
-    const size_t before = pieces.size();
-    dropEmptyPieces(pieces, sets, field);
-    const size_t dropped = before - pieces.size();
+    const size_t dropped = dropEmptyPieces(pieces, sets, field);
     std::vector<uint8_t> isLining(pieces.size(), 0);
     for (size_t p = 0; p < pieces.size(); ++p) isLining[p] = sets[p].isLining ? 1 : 0;
     ownBand(field, prismOf, isLining);
-    const double voxelVolume = field.voxelMm * field.voxelMm * field.voxelMm;
-    for (Piece& piece : pieces) piece.shellVolumeMm3 = 0.0;
-    for (size_t s = 0; s < field.owner.size(); ++s)
-        if (field.isInside(s) && field.owner[s] < pieces.size())
-            pieces[field.owner[s]].shellVolumeMm3 += voxelVolume;
     const size_t joined = joinRemnants(pieces, sets, field, cells, minPieceVolumeMm3);
     const size_t cuts = cutRings(pieces, sets, field);
     grouping.faces = faceContacts(field, cells, sets, pieces);

@@ -88,7 +88,7 @@ void markHit(AxisShadow& shadow, const Coord& ijk) {
     shadow.mark(u, v);
 }
 
-std::array<AxisShadow, 3> shadowsOf(const VoxelField& field) {
+std::array<AxisShadow, 3> emptyShadowsOf(const VoxelField& field) {
     std::array<AxisShadow, 3> out;
     if (field.leafOrigin.empty()) return out;
     // Over the leaves' bounds (a few voxels more than the inside's: columns no voxel hits).
@@ -96,6 +96,11 @@ std::array<AxisShadow, 3> shadowsOf(const VoxelField& field) {
     for (const Coord& o : field.leafOrigin) lo.minComponent(o), hi.maxComponent(o);
     hi.offset(7);
     for (int a = 0; a < 3; ++a) out[size_t(a)] = emptyShadow(a, lo, hi);
+    return out;
+}
+
+std::array<AxisShadow, 3> shadowsOf(const VoxelField& field) {
+    std::array<AxisShadow, 3> out = emptyShadowsOf(field);
     for (size_t s = 0; s < field.isActive.size(); ++s)
         if (field.isInside(s))
             for (AxisShadow& shadow : out) markHit(shadow, field.coordOf(s));
@@ -225,11 +230,15 @@ CrossingTunnels crossingTunnels(const VoxelField& field, size_t pieceCount, doub
     return out;
 }
 
+size_t liningPieces(const CrossingTunnels& tunnels, const std::vector<uint32_t>& pieces) {
+    return size_t(std::count_if(pieces.begin(), pieces.end(), [&](uint32_t p) {
+        return p < tunnels.liningShare.size() && tunnels.liningShare[p] >= 0.5;
+    }));
+}
+
 std::string crossingTunnelNote(const CrossingTunnels& tunnels, const std::vector<uint32_t>& unplaced,
                                size_t minPieces, size_t* lining) {
-    size_t count = 0;
-    for (uint32_t p : unplaced)
-        count += p < tunnels.liningShare.size() && tunnels.liningShare[p] >= 0.5 ? 1 : 0;
+    const size_t count = liningPieces(tunnels, unplaced);
     if (lining) *lining = 0;
     if (count < std::max<size_t>(1, minPieces) || 2 * count < unplaced.size()) return "";
     if (lining) *lining = count;
@@ -255,8 +264,7 @@ size_t crossingTunnelLining(const Pieces& out, const VoxelField& field, double w
     const CrossingTunnels tunnels =
         crossingTunnels(field, out.pieces.size(), 2.0 * wallMm, wallMm + 2.0 * field.voxelMm);
     if (!isMostRequired) {
-        const size_t lining = size_t(std::count_if(
-            unplaced.begin(), unplaced.end(), [&](uint32_t p) { return tunnels.liningShare[p] >= 0.5; }));
+        const size_t lining = liningPieces(tunnels, unplaced);
         return lining >= kMinCrossingLining ? lining : 0;
     }
     size_t lining = 0;

@@ -2,8 +2,8 @@
 /// @file The linings of two tunnels that cross, carved out of the partition's pieces (internal to
 /// lib/zomefab/pieces). The partition's pieces at a crossing hold parts of both linings and meet the
 /// frame along every direction. Each tunnel's lining is carved out along its prism instead (its core
-/// grown across its axis by a wall): a piece inside a prism slides along the tunnel past no ball
-/// and no strut. Where two prisms overlap the earlier axis (x, then y, then z) keeps the shell, so its
+/// grown across its axis by a wall and two voxels): a piece inside a prism slides along the tunnel past no
+/// ball and no strut. Where two prisms overlap the earlier axis (x, then y, then z) keeps the shell, so its
 /// lining runs through the crossing unbroken and goes on as glued rings, and the other tunnel's
 /// segments end against it with faces across their own axis, each glued onto a ring at its far
 /// end. Three tunnels through one point are not carved: there no lining at all crosses the
@@ -68,11 +68,11 @@ std::vector<TunnelPrism> crossingPrisms(const VoxelField& field, double minDiame
 /// voxel of a prism goes to a new piece, one per connected part of the voxels a prism owns (parts
 /// under a cubic centimetre stay with their piece); pieces left with no voxels are dropped and the
 /// rest renumbered; each remaining piece's cell set keeps out of every prism, each new one keeps to
-/// its prism and out of the earlier axes' prisms; the band's owners follow. Then every lining is cut
-/// across its axis into rings at the multiples of kTunnelSlabMm (slabOffsets, parts of at least
-/// @p minPieceVolumeMm3) and the face contacts are made again. Prisms of radius @p wallMm plus a
-/// voxel, which must stay under @p frameDMinMm (else nothing is carved). Returns how many pieces
-/// line the tunnels (0: nothing changed).
+/// its prism and out of the earlier axes' prisms; the band's owners follow; what is left of a piece
+/// under @p minPieceVolumeMm3 joins a neighbour. Then every lining is cut across its axis into equal
+/// rings no longer than kTunnelSlabMm and the face contacts are made again. Prisms of radius
+/// @p wallMm plus two voxels; nothing is carved unless the wall is under @p frameDMinMm. Returns how
+/// many pieces line the tunnels (0: nothing changed).
 size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
                             const GridCells& cells, double wallMm, double frameDMinMm,
                             double minPieceVolumeMm3, const RunContext& context);

@@ -78,6 +78,8 @@ struct AxisShadow {
 AxisShadow emptyShadow(int axis, const Coord& lo, const Coord& hi);
 /// Marks the column of voxel @p ijk as meeting the object.
 void markHit(AxisShadow& shadow, const Coord& ijk);
+/// Empty shadows along x, y and z over @p field's leaves' bounds (none for an empty field).
+std::array<AxisShadow, 3> emptyShadowsOf(const VoxelField& field);
 /// The shadows along x, y and z of @p field's inside voxels (empty for an empty field).
 std::array<AxisShadow, 3> shadowsOf(const VoxelField& field);
 
@@ -120,6 +122,9 @@ struct CrossingTunnels {
 /// (@p pieceCount of them).
 CrossingTunnels crossingTunnels(const VoxelField& field, size_t pieceCount, double minDiameterMm,
                                 double reachMm);
+
+/// How many of @p pieces line a tunnel that crosses another: half their voxels or more near one.
+size_t liningPieces(const CrossingTunnels& tunnels, const std::vector<uint32_t>& pieces);
 
 /// What a failed plan says when most of the pieces it placed nowhere line tunnels that cross
 /// (docs/mounting.md, "What is not done"): empty when fewer than half of them (or fewer than
