@@ -30,14 +30,18 @@ void addPlate(DepthRaster& r, double z0, uint32_t id) {
     r.addTriangle({-5, -5, z0}, {5, 5, z0}, {-5, 5, z0}, 0.0, id);
 }
 
-/// Does the plate at z = 0, pushed along +z, hit a sphere of radius 2 at @p center?
-SweepHit plateAgainstSphere(const Vec3d& center) {
+/// Does the plate at z = 0, pushed along +z (as far as @p reachMm; 0: without end), hit a sphere
+/// of radius 2 at @p center?
+SweepHit plateAgainstSphere(const Vec3d& center, double reachMm = 0.0) {
     const SweepAxes axes({0, 0, 1});
     const DepthRaster obstacles(axes, box({-40, -40, -40}, {40, 40, 40}), 0.5, true);
     DepthRaster frame = obstacles;
-    frame.addSphere(center, 2.0, 0.0, 7);
-    DepthRaster body(obstacles, box({-6, -6, -1}, {6, 6, 1}), false);
+    DepthRaster body(obstacles, box({-6, -6, -1}, {6, 6, 1}), false),
+        far(obstacles, box({-6, -6, -1}, {6, 6, 1}), true);
     addPlate(body, 0.0, 3);
+    addPlate(far, 0.0, 3);
+    if (reachMm > 0) frame.limitReach(far, reachMm);
+    frame.addSphere(center, 2.0, 0.0, 7);
     return worstHit(frame, body, 0.0);
 }
 
@@ -65,6 +69,16 @@ TEST_CASE("mount: a body pushed along +d hits what lies ahead of it, not what is
     CHECK_FALSE(plateAgainstSphere({1, 1, -30}).isHit);  // behind: the path leaves it
     CHECK_FALSE(plateAgainstSphere({9, 0, 30}).isHit);   // beside: 9 − 2 > 5, its shadow misses
     CHECK(plateAgainstSphere({6.5, 0, 30}).isHit);       // its shadow overlaps the plate's edge
+}
+
+TEST_CASE("mount: a body pushed only so far (a stave's lift) hits what it reaches, not what lies beyond") {
+    CHECK(plateAgainstSphere({1, 1, 30}).isHit);             // without end: the sphere 28 mm ahead
+    CHECK_FALSE(plateAgainstSphere({1, 1, 30}, 8.0).isHit);  // 8 mm: short of it
+    CHECK(plateAgainstSphere({1, 1, 9}, 8.0).isHit);         // its near side 7 mm ahead: met
+    const SweepHit clipped = plateAgainstSphere({1, 1, 9}, 8.0);
+    CHECK(clipped.overlapMm <= 8.0 + 1e-6);                   // counted only as far as the reach
+    CHECK_FALSE(plateAgainstSphere({1, 1, -30}, 8.0).isHit);  // behind: still not
+    CHECK_FALSE(plateAgainstSphere({9, 0, 5}, 8.0).isHit);    // beside: its shadow misses
 }
 
 TEST_CASE("mount: an edge-on face draws nothing unless grown; a window shares the pixel lattice") {

@@ -689,6 +689,38 @@ TEST_CASE("pieces.json: a stem cut through a thin wall reads back; a malformed c
     CHECK_THROWS_WITH_AS(piecesFromJson(far, ""), doctest::Contains("cut_mm[3] must lie on the stem"), Error);
 }
 
+TEST_CASE("pieces.json: a step of two legs (a stave) reads back; a malformed slide is refused") {
+    const partition::PartitionResult cells = quadrantCells(-15.3, 20.4);
+    Pieces made = makePieces(shell(), frame(), Transform4d::identity(), cells, printerOf({200, 200, 200}), {},
+                             RunContext::silent());
+    REQUIRE(!made.plan.steps.empty());
+    mount::MountStep& step = made.plan.steps.front();
+    step.slide = {0, 0.6, 0.8};
+    step.liftMm = 11.5;
+    const nlohmann::json j = piecesToJson(made, {"shell.vdb", "frame.json", "partition.json"});
+    const Pieces back = piecesFromJson(j, "");
+    const mount::MountStep& read = back.plan.steps.front();
+    CHECK(read.hasTwoLegs());
+    CHECK(read.liftMm == doctest::Approx(11.5));
+    CHECK(read.slide[1] == doctest::Approx(0.6));
+    CHECK(read.slide[2] == doctest::Approx(0.8));
+    for (size_t s = 1; s < back.plan.steps.size(); ++s) CHECK_FALSE(back.plan.steps[s].hasTwoLegs());
+    auto withSlide = [&](auto edit) {
+        nlohmann::json bad = j;
+        edit(bad["installation"]["steps"][0]["slide"]);
+        return bad;
+    };
+    CHECK_THROWS_WITH_AS(piecesFromJson(withSlide([](nlohmann::json& s) { s["lift_mm"] = -3; }), ""),
+                         doctest::Contains("slide.lift_mm must be in (0, 100] mm"), Error);
+    CHECK_THROWS_WITH_AS(piecesFromJson(withSlide([](nlohmann::json& s) {
+                                            s["frame"] = {0, 2, 0};
+                                        }),
+                                        ""),
+                         doctest::Contains("slide.frame must be a unit vector"), Error);
+    CHECK_THROWS_WITH_AS(piecesFromJson(withSlide([](nlohmann::json& s) { s.erase("frame"); }), ""),
+                         doctest::Contains("frame"), Error);
+}
+
 TEST_CASE("pieces: two pieces merged into one keep every voxel, and the others are numbered down") {
     QuadrantPieces q = quadrantPieces();
     VoxelField& field = q.field;

@@ -73,3 +73,33 @@ TEST_CASE("prismOwners: where two prisms overlap (round the crossing) the earlie
     CHECK(onlyY > 1000);
     CHECK(none > 10000);
 }
+
+TEST_CASE(
+    "crossingPrisms: three tunnels through one point get staved prisms; the later axis keeps the overlap") {
+    const VoxelField three = cubeWithTunnels(64, 10.0, {0, 1, 2}, 4.0);
+    bool isTriple = false;
+    const std::vector<TunnelPrism> prisms = crossingPrisms(three, 8.0, 6.0, 5.0, &isTriple, true);
+    CHECK(isTriple);
+    REQUIRE(prisms.size() == 3);
+    for (const TunnelPrism& p : prisms) {
+        CHECK(p.isStaved);
+        // Staves slide out through the mouths: the prism runs to the object's last voxels.
+        CHECK(p.loMm == doctest::Approx(0.0));
+        CHECK(p.hiMm == doctest::Approx(63.0));
+        CHECK(p.centerUMm == doctest::Approx(31.5).epsilon(0.02));
+        CHECK(p.centerVMm == doctest::Approx(31.5).epsilon(0.02));
+        CHECK(p.coreRadiusMm == doctest::Approx(10.0).epsilon(0.15));
+    }
+    const std::vector<uint32_t> owner = prismOwners(three, prisms, true);
+    size_t shared = 0;
+    for (size_t s = 0; s < owner.size(); ++s) {
+        if (!three.isInside(s)) continue;
+        const Coord ijk = three.coordOf(s);
+        uint32_t expected = kNone;
+        for (uint32_t k = 0; k < 3; ++k)
+            if (prisms[k].contains(ijk)) expected = k;  // the latest axis holding it
+        shared += prisms[0].contains(ijk) && prisms[2].contains(ijk);
+        if (owner[s] != expected) FAIL_CHECK("voxel owned by " << owner[s] << ", expected " << expected);
+    }
+    CHECK(shared > 100);
+}

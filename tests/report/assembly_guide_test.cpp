@@ -172,6 +172,30 @@ TEST_CASE("assembly_guide: a piece no peg holds is glued onto a piece already on
     CHECK(j["mounting"][1]["pegs"].empty());
 }
 
+TEST_CASE("assembly_guide: a stave slides in along its tunnel, then is pushed onto its pegs") {
+    const zome::Structure cube = cubeFrame();
+    std::vector<MountingStep> steps(2);
+    steps[0].pieces = {"piece-01"};
+    steps[0].hole = 17;  // blue, straight down: pushed on upward
+    steps[0].tenons = {{"piece-01", 0, 17}};
+    steps[0].slide = {1, 0, 0};  // slid off toward +x: in from the mouth on the right
+    steps[0].liftMm = 12.0;
+    steps[1].pieces = {"piece-02"};
+    steps[1].hole = 17;
+    steps[1].tenons = {{"piece-02", 1, 17}};
+    const AssemblyGuide g = assemblyGuide(cube, steps);
+    const std::string md = assemblyGuideMarkdown(g);
+    CHECK(
+        md.find("Slide it into the tunnel from its mouth on the side " + zome::directionName({1, 0, 0}) +
+                " (direction -1.000, +0.000, +0.000), held 12 mm off its place toward the tunnel's middle") !=
+        std::string::npos);
+    CHECK(md.find("Push it on from: ") != std::string::npos);
+    const nlohmann::json j = assemblyGuideToJson(g);
+    CHECK(j["mounting"][0]["lift_mm"] == 12.0);
+    CHECK(j["mounting"][0]["slide"][0] == -1.0);
+    CHECK_FALSE(j["mounting"][1].contains("slide"));  // one straight push
+}
+
 TEST_CASE("assembly_guide: same frame, same text") {
     const zome::Structure a = cubeFrame(), b = cubeFrame();
     CHECK(assemblyGuideMarkdown(assemblyGuide(a)) == assemblyGuideMarkdown(assemblyGuide(b)));

@@ -142,19 +142,26 @@ TEST_CASE("verify: a peg turned 10 degrees fails the peg axes") {
     CHECK(r.pieces[id].worstAxisDeg > 5.0);
 }
 
-TEST_CASE("verify: a ball in a piece's path fails the free path") {
-    verify::Assembly a = good().assembly;
-    const uint32_t id = loneHeldPiece(a);
+namespace {
+
+/// The failure lines of check @p name.
+std::vector<std::string> failuresOf(const verify::VerifyReport& r, const std::string& name) {
+    for (const verify::CheckResult& c : r.checks)
+        if (c.name == name) return c.failures;
+    return {};
+}
+
+/// @p a with a ball put on piece @p id's first tenon's axis, 30 mm past the piece's reach along its
+/// direction: in the way of its straight path off the frame.
+zome::BallId addBallInPath(verify::Assembly& a, uint32_t id) {
     const pieces::Piece& p = a.pieces.pieces[id];
     const pieces::Tenon& t = p.tenons[0];
-    // How far the piece reaches along its direction from the tenon's ball (frame mm).
     const Transform4d printToFrame = affineInverse(a.frameToGridMm) * affineInverse(p.gridToPrintMm);
     const Vec3d d = zome::holeDirection(p.hole);
     const Vec3d ballMm = a.frame.ball(t.ball).positionMm;
     double reachMm = 0;
     for (const Vec3f& v : p.mesh.positions)
         reachMm = std::max(reachMm, dot(sub(printToFrame.apply(toD(v)), ballMm), d));
-    // A new ball further out on the tenon's own axis: right in the piece's way off the frame.
     zome::GoldenVector3 at = a.frame.ball(t.ball).position;
     const zome::GoldenVector3 step = zome::strutVector(p.hole, 0);
     for (int i = 0; i < 1000; ++i) {
@@ -162,15 +169,54 @@ TEST_CASE("verify: a ball in a piece's path fails the free path") {
         const Vec3d mm = a.frame.scale().toMm(at);
         if (dot(sub(mm, ballMm), d) > reachMm + 30 && a.frame.findBall(at) == zome::kNoId) break;
     }
-    a.frame.addBall(at);
+    return a.frame.addBall(at);
+}
+
+mount::MountStep& stepOf(verify::Assembly& a, uint32_t piece) {
+    return a.pieces.plan.steps[size_t(a.pieces.plan.stepOf(piece))];
+}
+
+}  // namespace
+
+TEST_CASE("verify: a ball in a piece's path fails the free path") {
+    verify::Assembly a = good().assembly;
+    const uint32_t id = loneHeldPiece(a);
+    addBallInPath(a, id);
     const verify::VerifyReport r = check(a);
     CHECK(failed(r).count("free path") == 1);
     bool named = false;
-    for (const verify::CheckResult& c : r.checks)
-        if (c.name == "free path")
-            for (const std::string& f : c.failures)
-                named = named || f.find("piece " + std::to_string(id)) != std::string::npos;
+    for (const std::string& f : failuresOf(r, "free path"))
+        named = named || f.find("piece " + std::to_string(id)) != std::string::npos;
     CHECK(named);
+}
+
+TEST_CASE("verify: a step of two legs is lifted only as far as its lift, then slid along its slide") {
+    const uint32_t id = loneHeldPiece(good().assembly);
+    const Vec3d d = zome::holeDirection(good().assembly.pieces.pieces[id].hole);
+    // Lifted 8 mm, then slid on the same way: the straight path in two legs, and it passes.
+    verify::Assembly same = good().assembly;
+    stepOf(same, id).slide = d;
+    stepOf(same, id).liftMm = 8.0;
+    CHECK(failed(check(same)).empty());
+    // A ball 30 mm past the piece along its direction: in the way of the slide on, not of the lift.
+    verify::Assembly blocked = same;
+    const zome::BallId added = addBallInPath(blocked, id);
+    const verify::VerifyReport r = check(blocked);
+    CHECK(failed(r).count("free path") == 1);
+    bool isSlideNamed = false;
+    for (const std::string& f : failuresOf(r, "free path")) {
+        CHECK(f.find("lifted off its pegs") == std::string::npos);
+        isSlideNamed =
+            isSlideNamed || (f.find("piece " + std::to_string(id)) != std::string::npos &&
+                             f.find("slid off along its tunnel it meets ball") != std::string::npos);
+    }
+    CHECK(isSlideNamed);
+    // Slid off sideways instead, the ball is passed by: no leg of this step meets it.
+    verify::Assembly aside = blocked;
+    const Vec3d side = normalized(cross(d, std::abs(d[0]) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}));
+    stepOf(aside, id).slide = side;
+    for (const std::string& f : failuresOf(check(aside), "free path"))
+        CHECK(f.find("ball " + std::to_string(added) + " ") == std::string::npos);
 }
 
 TEST_CASE("verify: two pieces mounted with the blocked one first fail the order") {

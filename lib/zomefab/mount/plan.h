@@ -16,10 +16,18 @@
 
 namespace zomefab::mount {
 
-/// One mounting step: a piece, or a glued group, pushed on along −direction.
+/// One mounting step: a piece, or a glued group, pushed on along −direction. A step of two legs
+/// (a stave lining a tunnel: docs/mounting.md, "Three tunnels through one point") first slides in
+/// along −slide, held liftMm off its place along the direction, then is pushed on along
+/// −direction by liftMm onto its pegs: taken off, it is lifted off its pegs along +direction by
+/// liftMm, then slid off along +slide.
 struct MountStep {
     std::vector<uint32_t> pieces;  ///< one piece, or the members of a glued group
     int hole = -1;                 ///< the direction: zome hole 0..61
+    Vec3d slide{0, 0, 0};          ///< the first leg, a unit vector in frame coordinates; 0: none
+    double liftMm = 0.0;           ///< how far the last leg is (mm); 0: one straight push
+
+    bool hasTwoLegs() const { return liftMm > 0.0; }
 };
 
 struct InstallationPlan {

@@ -82,8 +82,24 @@ Vec3d DepthRaster::pointAt(int i, int j, double depth) const {
 double DepthRaster::px(const Vec3d& p) const { return (dot(p, mAxes.u) - mU0) / mPixel; }
 double DepthRaster::py(const Vec3d& p) const { return (dot(p, mAxes.v) - mV0) / mPixel; }
 
-void DepthRaster::put(int i, int j, double depth, uint32_t id) {
+void DepthRaster::limitReach(const DepthRaster& bodyFar, double reachMm) {
+    if (!mKeepMax || !bodyFar.mKeepMax || bodyFar.mPixel != mPixel)
+        throw Error(ErrorCode::Internal, "depth raster: a reach is kept by obstacles of a body's far side");
+    mReachOf = &bodyFar;
+    mReachMm = reachMm;
+    mReachDi = int(std::lround((bodyFar.mU0 - mU0) / mPixel));
+    mReachDj = int(std::lround((bodyFar.mV0 - mV0) / mPixel));
+}
+
+void DepthRaster::put(int i, int j, double depth, uint32_t id, double nearDepth) {
     if (i < 0 || j < 0 || i >= mWidth || j >= mHeight) return;
+    if (mReachOf) {
+        const int bi = i - mReachDi, bj = j - mReachDj;
+        if (bi < 0 || bj < 0 || bi >= mReachOf->mWidth || bj >= mReachOf->mHeight) return;
+        const double ceiling = double(mReachOf->depth(bi, bj)) + mReachMm;
+        if (!std::isfinite(ceiling) || nearDepth > ceiling) return;
+        depth = std::min(depth, ceiling);
+    }
     const size_t k = size_t(j) * size_t(mWidth) + size_t(i);
     if (mKeepMax ? depth > mDepth[k] : depth < mDepth[k]) {
         mDepth[k] = float(depth);
@@ -127,9 +143,13 @@ void forEachSpherePixel(int width, int height, double x, double y, double R, dou
 
 void DepthRaster::addSphere(const Vec3d& c, double radiusMm, double growMm, uint32_t id) {
     const double depth = dot(c, mAxes.d);
-    forEachSpherePixel(
-        mWidth, mHeight, px(c), py(c), (radiusMm + growMm) / mPixel, mPixel,
-        [&](int i, int j, double half) { put(i, j, mKeepMax ? depth + half : depth - half, id); });
+    forEachSpherePixel(mWidth, mHeight, px(c), py(c), (radiusMm + growMm) / mPixel, mPixel,
+                       [&](int i, int j, double half) {
+                           if (mKeepMax)
+                               put(i, j, depth + half, id, depth - half);
+                           else
+                               put(i, j, depth - half, id);
+                       });
 }
 
 void DepthRaster::addBallWithHole(const Vec3d& c, double radiusMm,
@@ -157,7 +177,7 @@ void DepthRaster::addBallWithHole(const Vec3d& c, double radiusMm,
                            double far = depth + half;
                            if (isInHole(mU0 + mPixel * (i + 0.5), mV0 + mPixel * (j + 0.5)))
                                far = std::min(far, floorDepth);
-                           put(i, j, far, id);
+                           put(i, j, far, id, depth - half);
                        });
 }
 

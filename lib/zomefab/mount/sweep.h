@@ -49,6 +49,12 @@ public:
     /// The point at @p depth on the line through pixel (i, j)'s centre.
     Vec3d pointAt(int i, int j, double depth) const;
 
+    /// Obstacles drawn after this call count only as far as @p reachMm beyond @p bodyFar's depth
+    /// on each line (a moving body drawn keeping its largest depth, a window of this raster's
+    /// lattice): the body moved along the direction by reachMm, not without end (a stave lifted
+    /// off its pegs before it slides along its tunnel). Nothing is drawn where bodyFar has nothing.
+    void limitReach(const DepthRaster& bodyFar, double reachMm);
+
     /// A point drawn into every pixel within @p radiusMm of its projection (0: its own pixel).
     void addPoint(const Vec3d& pMm, double radiusMm, uint32_t id);
     /// The near (obstacles) or far side of a sphere, grown by @p growMm.
@@ -68,7 +74,10 @@ public:
     void addTriangle(const Vec3d& a, const Vec3d& b, const Vec3d& c, double growMm, uint32_t id);
 
 private:
-    void put(int i, int j, double depth, uint32_t id);
+    /// Keeps @p depth at pixel (i, j); an obstacle that spans [nearDepth, depth] on the line is
+    /// clipped to the reach (limitReach).
+    void put(int i, int j, double depth, uint32_t id, double nearDepth);
+    void put(int i, int j, double depth, uint32_t id) { put(i, j, depth, id, depth); }
     /// Pixel coordinates of a point's projection (continuous).
     double px(const Vec3d& p) const;
     double py(const Vec3d& p) const;
@@ -80,6 +89,9 @@ private:
     bool mKeepMax = true;
     std::vector<float> mDepth;
     std::vector<uint32_t> mOwner;
+    const DepthRaster* mReachOf = nullptr;  ///< limitReach's body, or none
+    double mReachMm = 0.0;
+    int mReachDi = 0, mReachDj = 0;  ///< this raster's pixel (i, j) is mReachOf's (i − di, j − dj)
 };
 
 /// Where a moving body first meets obstacles on its path.

@@ -8,6 +8,7 @@
 #include "zomefab/core/disjoint_sets.h"
 #include "zomefab/core/error.h"
 #include "zomefab/core/format.h"
+#include "zomefab/pieces/detail/staves.h"
 #include "zomefab/sdf/level_set.h"
 
 namespace zomefab::pieces::detail {
@@ -259,20 +260,29 @@ FaceContacts faceContacts(const VoxelField& field, const GridCells& cells, const
     // or in two cells both pieces have, is a re-cut face (its plane is one of their half-spaces).
     // With each, the sum of the unit steps from the lower piece's voxel to the higher's: where no
     // plane separates the two (pieces that share a cell), its direction is the face's mean normal.
-    std::map<std::tuple<uint32_t, uint32_t, uint32_t, uint32_t>, std::pair<size_t, Vec3d>> counts;
+    // A stave's border (detail/staves.h) wraps round the tunnel's corners and rim: its faces are
+    // kept apart by the way the voxel step goes (one of six), so no mean normal points along a
+    // way that runs into it.
+    std::vector<uint8_t> isStave(sets.size(), 0);
+    for (size_t p = 0; p < sets.size(); ++p) isStave[p] = isStaveSet(sets[p]) ? 1 : 0;
+    std::map<std::tuple<uint32_t, uint32_t, uint32_t, uint32_t, int>, std::pair<size_t, Vec3d>> counts;
     forEachForwardPair(field, [&](size_t a, size_t b) {
         if (!field.isInside(a) || !field.isInside(b) || field.owner[a] == field.owner[b]) return;
         const Vec3d step = sub(field.world(field.coordOf(b)), field.world(field.coordOf(a)));
         const bool isSwapped = field.owner[a] > field.owner[b];
         if (isSwapped) std::swap(a, b);
-        auto& entry = counts[{field.owner[a], field.owner[b], field.cell[a], field.cell[b]}];
+        int way = 0;
+        if (isStave[field.owner[a]] || isStave[field.owner[b]])
+            for (int k = 0; k < 3; ++k)
+                if (step[size_t(k)] != 0.0) way = 1 + 2 * k + ((step[size_t(k)] > 0) != isSwapped ? 1 : 0);
+        auto& entry = counts[{field.owner[a], field.owner[b], field.cell[a], field.cell[b], way}];
         ++entry.first;
         entry.second = madd(entry.second, isSwapped ? -1.0 : 1.0, step);
     });
     FaceContacts faces;
     std::map<std::pair<uint32_t, uint32_t>, size_t> total;
     for (const auto& [key, entry] : counts) {
-        const auto [pa, pb, ca, cb] = key;
+        const auto [pa, pb, ca, cb, way] = key;
         const size_t count = entry.first;
         Vec3d normal{0, 0, 0};
         // Two cells of one piece's region are not cut from each other: where each piece has both
@@ -298,7 +308,7 @@ FaceContacts faceContacts(const VoxelField& field, const GridCells& cells, const
         auto same = std::find_if(list.begin(), list.end(),
                                  [&](const CutContact& c) { return dot(c.normal, normal) > 0.999999; });
         if (same == list.end())
-            list.push_back({normal, count});
+            list.push_back({normal, count, way != 0});
         else
             same->voxelFaces += count;
         total[{pa, pb}] += count;

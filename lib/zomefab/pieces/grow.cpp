@@ -21,6 +21,11 @@ namespace {
 /// Rounds of growth (each a plan): a piece with no peg can gain one ball per round and needs two.
 constexpr int kGrowRounds = 3;
 
+/// The frame grows toward at most this many staves no peg holds (a few tunnels' worth: the cube
+/// with three tunnels had 2). Each search tries every hole of every ball (bestGrowth), and where
+/// hundreds are unheld (the cheese at 700 mm: 793 of 998) one round cannot hold them all.
+constexpr size_t kMaxStavesToGrow = 48;
+
 /// A strut to add: from ball a through hole, of size; the candidate its new ball gives the piece.
 struct Growth {
     zome::BallId a = zome::kNoId;
@@ -134,6 +139,49 @@ std::vector<Growth> growthsFor(const zome::Structure& frame, uint32_t p, size_t 
 }
 
 }  // namespace
+
+size_t growFrameForStaves(Replanner& r, const StrutTest& canGrow) {
+    if (!canGrow || r.out.plan.isBuildable()) return 0;
+    if (const size_t unheld = unheldStaves(r.out.plan.holeOfPiece, r.grouping.cellSets);
+        unheld > kMaxStavesToGrow) {
+        r.context.debug("mounting: " + std::to_string(unheld) +
+                        " staves no peg holds: too many to grow the frame toward");
+        return 0;
+    }
+    const std::vector<Box3d> boxes = pieceBoxes(r.field, r.out.pieces.size());
+    const PlannerInput input = plannerInput(r.out, r.field, r.candidates);
+    const size_t minPegs = size_t(std::max(1, r.opt.tenons.minPerPiece));
+    zome::Structure trial = r.frame;
+    size_t added = 0, unheld = 0;
+    for (uint32_t p = 0; p < r.out.pieces.size(); ++p) {
+        if (r.out.plan.holeOfPiece[p] >= 0 || boxes[p].isEmpty()) continue;
+        const std::optional<Stave> st = staveOf(r.grouping.cellSets[p], input.pieces[p].voxels);
+        if (!st) continue;
+        ++unheld;
+        // The directions it may take, the nearest to its lift reversed first.
+        std::vector<std::pair<double, int>> holes;
+        for (int h = 0; h < zome::kHoleCount; ++h)
+            if (const Vec3d d = gridDirection(h, r.frameToGridMm); isStaveDirection(*st, d))
+                holes.push_back({dot(d, st->liftGrid), h});
+        std::sort(holes.begin(), holes.end());
+        for (const auto& [lean, hole] : holes) {
+            const std::vector<Growth> list = growthsAlong(trial, p, hole, minPegs, boxes[p], r, canGrow);
+            for (const Growth& g : list)
+                if (canGrow(trial, g.a, g.hole, g.size)) addGrowth(trial, g), ++added;
+            if (!list.empty()) break;
+        }
+    }
+    r.context.debug("mounting: growing the frame: " + std::to_string(added) + " strut(s) found for " +
+                    std::to_string(unheld) + " stave(s) no peg holds");
+    if (added == 0) return 0;
+    const std::optional<size_t> kept = r.tryChange(
+        [&] { r.frame = std::move(trial); }, SIZE_MAX,
+        "frame grown by " + std::to_string(added) + " struts toward staves", Replanner::Change::kFrame);
+    if (!kept) return 0;
+    r.context.detail("the frame grew by " + std::to_string(added) +
+                     " strut(s), each to a new ball, toward staves no peg held");
+    return added;
+}
 
 size_t growFrameForPieces(Replanner& r, const StrutTest& canGrow) {
     if (!canGrow) return 0;

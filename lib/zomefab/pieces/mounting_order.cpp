@@ -97,7 +97,8 @@ bool facesAllow(const MountBody& still, const MountBody& moving, const Vec3d& d,
             if (it == faces.end()) continue;
             *isTouching = true;
             for (const CutContact& c : it->second) {
-                if (c.voxelFaces < kMinOrderFaceVoxels) continue;  // in the sweeps (plannerInput)
+                if (c.voxelFaces < kMinOrderFaceVoxels && !c.isStaveBorder)
+                    continue;  // in the sweeps (plannerInput)
                 // The stored normal points from the lower piece into the higher: here, into moving.
                 const Vec3d n = x < y ? c.normal : scale(c.normal, -1.0);
                 isOk = isOk && mount::faceOrder(n, d, d).isBAfterAOk;
@@ -162,14 +163,14 @@ struct Bodies {
 /// many pairs were glued.
 size_t glueStuck(Bodies& bodies, const Disassembly& parts, const PlannerInput& input,
                  const FrameSweeps& sweeps, const FaceContacts& faces, double voxelMm, int maxPerPiece,
-                 std::set<std::vector<uint32_t>>& noFreeUnion) {
+                 std::set<std::vector<uint32_t>>& noFreeUnion, size_t fixedCount) {
     auto blocks = [&](size_t k, uint32_t other) {
         const std::vector<uint32_t>& list = parts.stuckBlockers[k];
         return std::find(list.begin(), list.end(), other) != list.end();
     };
     std::vector<std::tuple<int, size_t, uint32_t, uint32_t>> pairs;  // (−kind, −contact, a, b)
     for (size_t i = 0; i < parts.stuck.size(); ++i)
-        for (uint32_t b = 0; b < bodies.list.size(); ++b) {
+        for (uint32_t b = 0; b + fixedCount < bodies.list.size(); ++b) {
             const uint32_t a = parts.stuck[i];
             const auto other = std::find(parts.stuck.begin(), parts.stuck.end(), b);
             if (b == a || (other != parts.stuck.end() && b < a)) continue;  // each stuck pair once
@@ -209,7 +210,9 @@ size_t glueStuck(Bodies& bodies, const Disassembly& parts, const PlannerInput& i
     return count;
 }
 
-mount::InstallationPlan writePlan(const Bodies& bodies, const Disassembly& parts, size_t pieceCount) {
+/// The plan of @p parts; the last @p fixedCount bodies are staves, whose problems are the caller's.
+mount::InstallationPlan writePlan(const Bodies& bodies, const Disassembly& parts, size_t pieceCount,
+                                  size_t fixedCount) {
     mount::InstallationPlan plan;
     plan.holeOfPiece.assign(pieceCount, -1);
     plan.groupOf.assign(pieceCount, 0);
@@ -223,7 +226,7 @@ mount::InstallationPlan writePlan(const Bodies& bodies, const Disassembly& parts
     for (const auto& [a, b] : parts.before)
         plan.before.push_back({bodies.list[a].pieces[0], bodies.list[b].pieces[0]});
     plan.gluedOn = parts.gluedOn;
-    for (size_t b = 0; b < bodies.list.size(); ++b) {
+    for (size_t b = 0; b + fixedCount < bodies.list.size(); ++b) {
         const MountBody& body = bodies.list[b];
         if (parts.holes[b] >= 0 || std::count(parts.stuck.begin(), parts.stuck.end(), uint32_t(b))) continue;
         std::string why = body.options.empty() ? "no ball's hole points at it within a tenon's reach"
@@ -293,6 +296,7 @@ struct Usable {
 /// once asked for, the bodies in the way of each.
 struct BodyState {
     std::vector<Usable> usable;
+    bool isFixed = false;  ///< in place throughout (a stave): never taken away, in every body's way
     std::vector<std::optional<std::vector<uint32_t>>> blockers;
     bool canGlue() const { return !usable.empty() && usable.back().isGlue; }
 };
@@ -331,7 +335,7 @@ const std::vector<uint32_t>& blockersOf(std::vector<BodyState>& state, uint32_t 
     std::vector<uint32_t> toSweep;
     std::vector<uint8_t> touching(n, 0);
     for (uint32_t a = 0; a < n; ++a) {
-        if (a == b || state[a].usable.empty()) continue;
+        if (a == b || (state[a].usable.empty() && !state[a].isFixed)) continue;
         bool isTouching = false;
         if (!facesAllow(bodies[a], bodies[b], d, faces, &isTouching)) {
             isBlocked[a] = 1;
@@ -389,7 +393,7 @@ std::vector<HostFace> hostFaces(const std::vector<MountBody>& bodies, uint32_t b
 
 Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts& faces,
                         const Transform4d& frameToGridMm, double voxelMm, const GlueOnRule& glueOn,
-                        SweepCache& cache, const RunContext& context) {
+                        SweepCache& cache, const RunContext& context, size_t fixedCount) {
     const size_t n = bodies.size();
     std::vector<BodyState> state(n);
     std::vector<std::vector<HostFace>> hosts(n);
@@ -397,6 +401,10 @@ Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts
     size_t left = 0;
     for (uint32_t b = 0; b < n; ++b) {
         BodyState& st = state[b];
+        if (b + fixedCount >= n) {
+            st.isFixed = true, isLeft[b] = 1;
+            continue;
+        }
         if (!bodies[b].glueOptions.empty()) hosts[b] = hostFaces(bodies, b, faces, voxelMm, glueOn);
         st.usable = usableOf(bodies[b], !hosts[b].empty());
         st.blockers.resize(st.usable.size());
@@ -438,7 +446,7 @@ Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts
         // Taking the highest first mounts the lowest first.
         std::optional<std::tuple<int, size_t, double, uint32_t>> best;
         for (uint32_t b = 0; b < n; ++b) {
-            if (!isLeft[b]) continue;
+            if (!isLeft[b] || state[b].isFixed) continue;
             const int lastHost = isLastHost(b) ? 1 : 0;
             const bool hasPegs = !state[b].usable.front().isGlue;
             for (size_t k = 0; k < state[b].usable.size(); ++k) {
@@ -468,7 +476,7 @@ Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts
     for (uint32_t b = 0; b < n; ++b) {
         if (chosen[b] != SIZE_MAX) {
             for (uint32_t a : *state[b].blockers[chosen[b]]) out.before.push_back({b, a});
-        } else if (isLeft[b]) {
+        } else if (isLeft[b] && !state[b].isFixed) {
             out.stuck.push_back(b);
             std::vector<uint32_t> in;
             for (uint32_t a : blockersOf(state, b, 0, bodies, faces, frameToGridMm, voxelMm, cache))
@@ -492,9 +500,10 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
     std::vector<uint32_t> bodyOf(input.pieces.size());
     std::vector<std::vector<uint32_t>> members(input.pieces.size());
     for (uint32_t p = 0; p < input.pieces.size(); ++p) bodyOf[p] = p, members[p] = {p};
+    auto isStave = [&](uint32_t p) { return p < input.staves.size() && input.staves[p].has_value(); };
     for (const auto& [a, b] : input.preGlued) {
         const uint32_t ba = bodyOf[a], bb = bodyOf[b];
-        if (ba == bb) continue;
+        if (ba == bb || isStave(a) || isStave(b)) continue;
         MountBody sideA, sideB;
         sideA.pieces = members[ba], sideB.pieces = members[bb];
         bodies.glued.push_back(gluePair(sideA, sideB, faces));
@@ -502,21 +511,41 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
         members[ba].insert(members[ba].end(), members[bb].begin(), members[bb].end());
         members[bb].clear();
     }
+    std::vector<uint32_t> staves;
     for (uint32_t p = 0; p < input.pieces.size(); ++p) {
         if (members[p].empty()) continue;
+        if (isStave(p)) {
+            staves.push_back(p);
+            continue;
+        }
         bodies.list.push_back(makeBody(members[p], input, sweeps, voxelMm, maxPerPiece));
         if (bodies.list.back().isHosted()) addGlueOptions(bodies.list.back(), holes, sweeps, voxelMm);
         context.throwIfCancelled();
     }
+    // Staves go on first, in their order, and stay in every other body's way: the fixed bodies at
+    // the end of the list.
+    std::sort(staves.begin(), staves.end(), [&](uint32_t a, uint32_t b) {
+        return std::tie(input.staves[a]->rank, a) < std::tie(input.staves[b]->rank, b);
+    });
+    std::vector<int> staveHoles(staves.size(), -1);
+    for (size_t k = 0; k < staves.size(); ++k)
+        bodies.list.push_back(
+            staveBody(staves[k], input, sweeps.frameToGridMm(), maxPerPiece, &staveHoles[k]));
+    const size_t fixed = staves.size();
+    // A stave no hole holds leaves no plan to be carried out: the frame must grow toward it first
+    // (growFrameForStaves), and an order of the rest is not sought (the cheese at 700 mm: minutes).
+    if (std::count(staveHoles.begin(), staveHoles.end(), -1) > 0)
+        return unheldStavesPlan(input, staves, staveHoles, sweeps.frameToGridMm());
     SweepCache cache;
     const GlueOnRule glueOn;
     Disassembly parts =
-        disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context);
+        disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context, fixed);
     // Bodies held by pegs but stuck may be glued on instead, along a direction no peg uses.
     if (!parts.stuck.empty()) {
         for (uint32_t b : parts.stuck)
             if (bodies.list[b].glueOptions.empty()) addGlueOptions(bodies.list[b], holes, sweeps, voxelMm);
-        parts = disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context);
+        parts =
+            disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context, fixed);
     }
     // Where no order exists, glue stuck bodies that are in each other's way into one (a few times:
     // what gluing does not resolve is re-cut).
@@ -546,16 +575,21 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
                           d + ", in its way:" + in);
         }
         const size_t glued =
-            glueStuck(bodies, parts, input, sweeps, faces, voxelMm, maxPerPiece, noFreeUnion);
+            glueStuck(bodies, parts, input, sweeps, faces, voxelMm, maxPerPiece, noFreeUnion, fixed);
         if (glued == 0) break;
         glues += glued;
         context.debug("mounting: " + std::to_string(parts.stuck.size()) + " bodies stuck, " +
                       std::to_string(glued) + " pairs glued into one");
-        parts = disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context);
+        parts =
+            disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context, fixed);
         stall = parts.stuck.size() < fewestStuck ? 0 : stall + 1;
         fewestStuck = std::min(fewestStuck, parts.stuck.size());
     }
-    return writePlan(bodies, parts, input.pieces.size());
+    const size_t firstStave = bodies.list.size() - fixed;
+    for (size_t k = 0; k < fixed; ++k) parts.holes[firstStave + k] = staveHoles[k];
+    mount::InstallationPlan plan = writePlan(bodies, parts, input.pieces.size(), fixed);
+    addStaveSteps(plan, input, staves, staveHoles, sweeps.frameToGridMm());
+    return plan;
 }
 
 }  // namespace zomefab::pieces::detail

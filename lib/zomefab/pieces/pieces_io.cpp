@@ -32,9 +32,16 @@ json directionToJson(int hole, const Transform4d& frameToGridMm) {
             {"name", zome::directionName(d)}};
 }
 
-json installationToJson(const mount::InstallationPlan& plan) {
+json installationToJson(const mount::InstallationPlan& plan, const Transform4d& frameToGridMm) {
     json steps = json::array();
-    for (const mount::MountStep& s : plan.steps) steps.push_back({{"pieces", s.pieces}, {"hole", s.hole}});
+    for (const mount::MountStep& s : plan.steps) {
+        json step = {{"pieces", s.pieces}, {"hole", s.hole}};
+        if (s.hasTwoLegs())  // slid in along −slide first, then pushed on by lift_mm
+            step["slide"] = {{"frame", toJson(s.slide)},
+                             {"grid", toJson(normalized(applyLinear(frameToGridMm, s.slide)))},
+                             {"lift_mm", s.liftMm}};
+        steps.push_back(std::move(step));
+    }
     json before = json::array();
     for (const auto& [a, b] : plan.before) before.push_back({a, b});
     json glued = json::array();
@@ -201,7 +208,7 @@ json piecesToJson(const Pieces& all, const PiecesJsonInfo& info) {
                           {"label_note", p.label ? json(nullptr) : json(p.labelNote)}});
     }
     j["pieces"] = pieces;
-    j["installation"] = installationToJson(all.plan);
+    j["installation"] = installationToJson(all.plan, all.frameToGridMm);
     j["summary"] = {{"pieces", all.pieces.size()},
                     {"volume_mm3", total},
                     {"shell_volume_mm3", all.shellVolumeMm3},

@@ -238,6 +238,16 @@ mount::InstallationPlan planFromJson(const json& j, const std::vector<Piece>& pi
         step.hole = intFromJson(requireMember(steps[s], "hole", what), what + ".hole");
         if (step.pieces.empty()) fail(what + ".pieces must not be empty");
         if (step.hole < -1 || step.hole >= zome::kHoleCount) fail(what + ".hole must be in -1..61");
+        if (const auto slide = steps[s].find("slide"); slide != steps[s].end()) {
+            const std::string where = what + ".slide";
+            if (!slide->is_object()) fail(where + " must be an object");
+            step.slide = vec3FromJson(requireMember(*slide, "frame", where), where + ".frame");
+            step.liftMm = numberFromJson(requireMember(*slide, "lift_mm", where), where + ".lift_mm");
+            // A lift of more than a tunnel across is no stave's: such a file was not written by zomefab.
+            if (!(step.liftMm > 0.0 && step.liftMm <= 100.0)) fail(where + ".lift_mm must be in (0, 100] mm");
+            if (std::abs(norm(step.slide) - 1.0) > 1e-3) fail(where + ".frame must be a unit vector");
+            if (step.hole < 0) fail(what + " slides but has no direction to be pushed on along");
+        }
         for (uint32_t p : step.pieces) {
             if (p >= n) fail(what + " names piece " + std::to_string(p) + ", which does not exist");
             if (isPlaced[p]) fail(what + " mounts piece " + std::to_string(p) + " a second time");

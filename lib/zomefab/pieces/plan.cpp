@@ -15,10 +15,10 @@
 #include "zomefab/pieces/detail/merges.h"
 #include "zomefab/pieces/detail/mounting.h"
 #include "zomefab/pieces/detail/pins.h"
-#include "zomefab/pieces/detail/prisms.h"
 #include "zomefab/pieces/detail/replan.h"
 #include "zomefab/pieces/detail/splits.h"
 #include "zomefab/pieces/detail/stages.h"
+#include "zomefab/pieces/detail/staves.h"
 #include "zomefab/pieces/detail/thin_wall.h"
 #include "zomefab/pieces/detail/tunnels.h"
 
@@ -97,6 +97,7 @@ size_t recutBlocked(Pieces& out, VoxelField& field, const GridCells& cells, Grou
     const SplitSearch search = splitSearchFor(field, opt);
     size_t cut = 0;
     for (uint32_t p : piecesToRecut(out, input, sweeps, field.voxelMm, opt.tenons.maxPerPiece)) {
+        if (isStaveSet(grouping.cellSets[p])) continue;  // its seams run along its lift
         const std::vector<const TenonCandidate*> mine = usableCandidates(candidates, {p});
         context.throwIfCancelled();
         std::vector<Vec3d> voxels;
@@ -136,7 +137,8 @@ size_t cutKeystone(Pieces& out, VoxelField& field, const GridCells& cells, Group
     const mount::InstallationPlan plan = planUnglued(input, sweeps, grouping, field.voxelMm, opt, context);
     std::vector<std::pair<double, uint32_t>> stuck;  // (−volume, piece)
     for (uint32_t p = 0; p < out.pieces.size(); ++p)
-        if (plan.holeOfPiece[p] < 0 && !input.candidatesByHole[p].empty())
+        if (plan.holeOfPiece[p] < 0 && !input.candidatesByHole[p].empty() &&
+            !isStaveSet(grouping.cellSets[p]))
             stuck.push_back({-out.pieces[p].shellVolumeMm3, p});
     std::sort(stuck.begin(), stuck.end());
     const std::vector<std::vector<size_t>> slots = slotsOfPieces(field, out.pieces.size());
@@ -298,59 +300,6 @@ size_t markLostTenons(const mount::InstallationPlan& plan, const TenonPlan& teno
 
 }  // namespace
 
-namespace {
-
-/// The stem of tenon @p t (its tapered prism, ball face to wall) drawn into @p r as its 12 triangles,
-/// grown by @p growMm (tenonHullMm's first 8 points: the corners at the ball's end, then at the wall).
-void drawStem(mount::DepthRaster& r, const Tenon& t, const TenonOptions& o, double growMm, uint32_t id) {
-    const std::vector<Vec3d> c = tenonHullMm(t, o);
-    // Corner k = 2·l + s (l, s: the sides); the quads of the two ends and of the four sides.
-    static constexpr int kQuads[6][4] = {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                         {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}};
-    for (const auto& q : kQuads) {
-        r.addTriangle(c[size_t(q[0])], c[size_t(q[1])], c[size_t(q[2])], growMm, id);
-        r.addTriangle(c[size_t(q[0])], c[size_t(q[2])], c[size_t(q[3])], growMm, id);
-    }
-}
-
-}  // namespace
-
-size_t markTenonsInPaths(const mount::InstallationPlan& plan, const TenonPlan& tenons,
-                         const PlannerInput& input, const Transform4d& frameToGridMm, const TenonOptions& o,
-                         double voxelMm, std::vector<TenonCandidate>& candidates,
-                         std::set<std::pair<zome::BallId, int>>& lost) {
-    std::vector<const Tenon*> before;  // the tenons of the steps already on
-    std::set<std::pair<zome::BallId, int>> found;
-    for (const mount::MountStep& step : plan.steps) {
-        if (step.hole >= 0 && !before.empty()) {
-            const Vec3d d = gridDirection(step.hole, frameToGridMm);
-            Box3d bounds;
-            for (uint32_t p : step.pieces)
-                bounds.expand(input.pieces[p].bounds.min), bounds.expand(input.pieces[p].bounds.max);
-            for (const Tenon* t : before) {
-                const Box3d stem = tenonBoundsMm(*t, o);
-                if (!shadowsMeet(bounds, stem, d)) continue;
-                Box3d both = bounds;
-                both.expand(stem.min), both.expand(stem.max);
-                const mount::SweepAxes axes(d);
-                mount::DepthRaster obstacle(axes, both, voxelMm, true, voxelMm),
-                    body(axes, both, voxelMm, false, voxelMm);
-                drawStem(obstacle, *t, o, 0.5 * voxelMm, 0);
-                for (uint32_t p : step.pieces)
-                    for (const Vec3d& x : input.pieces[p].voxels) body.addPoint(x, 0.0, p);
-                if (mount::worstHit(obstacle, body, voxelMm).isHit) found.insert({t->ball, t->hole});
-            }
-        }
-        for (uint32_t p : step.pieces)
-            for (const Tenon& t : tenons.perPiece[p]) before.push_back(&t);
-    }
-    for (TenonCandidate& c : candidates)
-        if (c.rejection.empty() && found.count({c.tenon.ball, c.tenon.hole}))
-            c.rejection = "in another piece's path";
-    lost.insert(found.begin(), found.end());
-    return found.size();
-}
-
 SplitSearch splitSearchFor(const VoxelField& field, const PiecesOptions& opt) {
     SplitSearch search;
     search.voxelMm = field.voxelMm;
@@ -373,19 +322,27 @@ std::vector<const TenonCandidate*> usableCandidates(const std::vector<TenonCandi
 }
 
 mount::InstallationPlan planOverCandidates(const Pieces& out, const VoxelField& field,
-                                           const FaceContacts& faces, const FrameSweeps& sweeps,
+                                           const Grouping& grouping, const FrameSweeps& sweeps,
                                            std::vector<TenonCandidate>& candidates,
                                            std::set<std::pair<zome::BallId, int>>& lost,
                                            const PiecesOptions& opt, const RunContext& context,
                                            const std::vector<std::pair<uint32_t, uint32_t>>& preGlued) {
     for (int attempt = 0;; ++attempt) {
+        for (TenonCandidate& c : candidates)
+            c.isStave = c.piece >= 0 && size_t(c.piece) < grouping.cellSets.size() &&
+                        isStaveSet(grouping.cellSets[size_t(c.piece)]);
         PlannerInput input = plannerInput(out, field, candidates);
         input.preGlued = preGlued;
+        for (size_t p = 0; p < out.pieces.size(); ++p)
+            if (std::optional<Stave> st = staveOf(grouping.cellSets[p], input.pieces[p].voxels)) {
+                input.staves.resize(out.pieces.size());
+                input.staves[p] = st;
+            }
         // A plan with glued groups of its own is a trial (glueUnderHeld): it gives up where no order
         // exists rather than glue more (each round of that took 4 s on the demo, and never helped).
         input.isGluingStuck = preGlued.empty();
         mount::InstallationPlan plan =
-            planMounting(input, sweeps, faces, field.voxelMm, tenonHoleSet(opt.tenons.holes),
+            planMounting(input, sweeps, grouping.faces, field.voxelMm, tenonHoleSet(opt.tenons.holes),
                          opt.tenons.maxPerPiece, context);
         if (!plan.isBuildable() || attempt == 8) return plan;
         const TenonPlan tenons = chooseTenons(candidates, plan.holeOfPiece, opt.tenons);
@@ -442,7 +399,7 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         context.debug("mounting: " + std::to_string(candidates.size()) + " tenon candidates in " +
                       formatNumber(clock.seconds(), 3) + " s");
         context.throwIfCancelled();
-        out.plan = planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context);
+        out.plan = planOverCandidates(out, field, grouping, sweeps, candidates, lost, opt, context);
         const PlannerInput input = plannerInput(out, field, candidates);
         context.debug("mounting: plan " + std::to_string(round) + " in " + formatNumber(clock.seconds(), 3) +
                       " s");
@@ -464,6 +421,8 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         if (round == 0 && unplaced <= kMaxTunnelStuck &&
             cutTunnelLinings(out, field, cells, grouping, input, sweeps, opt, context) > 0)
             continue;
+        // Staves no hole holds: no cut helps them, the frame must grow toward them (below).
+        if (unheldStaves(out.plan.holeOfPiece, grouping.cellSets) > 0) break;
         // A piece no hole reaches and nothing glues on stays so whatever is re-cut (the cheese at
         // 400 mm, on a frame of 4 balls: a re-cut round and a plan, 127 s, for nothing).
         if (const auto none = unplaceablePieces(out.plan, input, grouping.faces, field.voxelMm);
@@ -499,6 +458,7 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
     }
     Replanner replanner(out, field, cells, grouping, probe, frame, frameToGridMm, sweeps, remakeSweeps,
                         candidates, lost, opt, context);
+    if (opt.isGrowingFrame && canGrow) out.frameStrutsGrown += growFrameForStaves(replanner, canGrow);
     if (opt.isGrowingFrame && canGrow && opt.tenons.minPerPiece > 0)
         out.frameStrutsGrown += growFrameForPieces(replanner, canGrow);
     mergeUnderHeld(replanner, fabrication);
@@ -522,6 +482,7 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
         out.pieces[p].tenons = std::move(plan.perPiece[p]);
         out.pieces[p].tenonShortfall = std::move(plan.shortfall[p]);
     }
+    setStaveLifts(out, field, frameToGridMm, fabrication.frameDMinMm());
     warnShortfall(out, opt.tenons, context);
     for (const std::string& problem : out.plan.problems) context.warn("installation plan: " + problem);
 }
@@ -557,7 +518,8 @@ void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping
     // What follows is for pieces that will be made; a plan with problems is refused (requireBuildable),
     // unless there are no tenons to plan (--max-tenons 0: pieces without a plan, numbered all the same).
     if (opt.tenons.maxPerPiece > 0 && !out.plan.isBuildable()) {
-        noteCrossingTunnels(out, field, fabrication.wallMm);
+        if (noteUnheldStaves(out, grouping.cellSets) == 0)
+            noteCrossingTunnels(out, field, fabrication.wallMm);
         return;
     }
     // The printed wall, where thinner than the plan's (thin_wall.h): after the plan, before numbers.

@@ -11,6 +11,7 @@
 #include "zomefab/core/format.h"
 #include "zomefab/pieces/detail/merges.h"
 #include "zomefab/pieces/detail/splits.h"
+#include "zomefab/pieces/detail/staves.h"
 
 namespace zomefab::pieces::detail {
 
@@ -160,6 +161,10 @@ TunnelPrism tunnelPrism(const TunnelCore& core, const VoxelField& field, double 
     for (const auto& [u, v] : core.columns)
         minU = std::min(minU, u), maxU = std::max(maxU, u), minV = std::min(minV, v),
         maxV = std::max(maxV, v);
+    const size_t u = size_t(core.axis + 1) % 3, v = size_t(core.axis + 2) % 3;
+    p.centerUMm = field.originMm[u] + field.voxelMm * 0.5 * (minU + maxU);
+    p.centerVMm = field.originMm[v] + field.voxelMm * 0.5 * (minV + maxV);
+    p.coreRadiusMm = field.voxelMm * 0.25 * (maxU - minU + maxV - minV + 2);
     const int margin = int(std::ceil(radiusMm / field.voxelMm)) + 2;
     p.loU = minU - margin, p.loV = minV - margin;
     p.sizeU = maxU - minU + 1 + 2 * margin, p.sizeV = maxV - minV + 1 + 2 * margin;
@@ -187,14 +192,16 @@ TunnelPrism tunnelPrism(const TunnelCore& core, const VoxelField& field, double 
     return p;
 }
 
-std::vector<uint32_t> prismOwners(const VoxelField& field, const std::vector<TunnelPrism>& prisms) {
+std::vector<uint32_t> prismOwners(const VoxelField& field, const std::vector<TunnelPrism>& prisms,
+                                  bool isLaterFirst) {
     std::vector<uint32_t> out(field.owner.size(), kNone);
     if (prisms.empty() || field.leafOrigin.empty()) return out;
     const PrismLookup lookup = prismLookup(field, prisms);
     for (size_t s = 0; s < out.size(); ++s) {
         if (!field.isActive[s]) continue;
         const Coord ijk = field.coordOf(s);
-        for (int a = 0; a < 3; ++a) {
+        for (int i = 0; i < 3; ++i) {
+            const int a = isLaterFirst ? 2 - i : i;
             const uint32_t k = lookup.at(a, ijk);
             if (k != kNone && prisms[k].contains(ijk)) {
                 out[s] = k;
@@ -206,7 +213,7 @@ std::vector<uint32_t> prismOwners(const VoxelField& field, const std::vector<Tun
 }
 
 std::vector<TunnelPrism> crossingPrisms(const VoxelField& field, double minDiameterMm, double radiusMm,
-                                        double endMm, bool* isTriple) {
+                                        double endMm, bool* isTriple, bool isStaving) {
     if (isTriple) *isTriple = false;
     const std::array<AxisShadow, 3> shadows = shadowsOf(field);
     if (shadows[0].isHit.empty()) return {};
@@ -216,13 +223,18 @@ std::vector<TunnelPrism> crossingPrisms(const VoxelField& field, double minDiame
     for (size_t i = 0; i < cores.size(); ++i)
         if (crosses[i]) crossing.push_back(cores[i]);
     if (crossing.empty()) return {};
-    if (hasTripleCrossing(crossing)) {
+    const bool isStaved = hasTripleCrossing(crossing);
+    if (isStaved) {
         if (isTriple) *isTriple = true;
-        return {};
+        if (!isStaving) return {};
+        endMm = 0.0;  // staves slide out through the mouths: the rims are theirs
     }
     const double inf = std::numeric_limits<double>::infinity();
     std::vector<TunnelPrism> prisms;
-    for (const TunnelCore& core : crossing) prisms.push_back(tunnelPrism(core, field, radiusMm, -inf, inf));
+    for (const TunnelCore& core : crossing) {
+        prisms.push_back(tunnelPrism(core, field, radiusMm, -inf, inf));
+        prisms.back().isStaved = isStaved;
+    }
     // Each prism's ends: where the object's voxels on its lines end, less the mouth's own shell.
     const PrismLookup lookup = prismLookup(field, prisms);
     std::vector<double> lo(prisms.size(), inf), hi(prisms.size(), -inf);
@@ -250,7 +262,7 @@ namespace {
 /// prism's edge grazes the shell) stay with their piece. Returns each new piece's prism.
 std::vector<uint32_t> carveParts(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field,
                                  const std::vector<std::shared_ptr<const TunnelPrism>>& prisms,
-                                 const std::vector<uint32_t>& prismOf) {
+                                 const std::vector<uint32_t>& prismOf, bool isLaterFirst) {
     const size_t minVoxels = size_t(std::ceil(1000.0 / (field.voxelMm * field.voxelMm * field.voxelMm)));
     const size_t oldCount = pieces.size();
     std::vector<uint8_t> marked(field.owner.size(), 0);
@@ -285,7 +297,8 @@ std::vector<uint32_t> carveParts(std::vector<Piece>& pieces, std::vector<CellSet
         const uint32_t own = prismOf[s];
         set.prisms.push_back({prisms[own], true});
         for (const auto& prism : prisms)
-            if (prism->axis < prisms[own]->axis) set.prisms.push_back({prism, false});
+            if (isLaterFirst ? prism->axis > prisms[own]->axis : prism->axis < prisms[own]->axis)
+                set.prisms.push_back({prism, false});
         pieces.push_back(std::move(piece));
         sets.push_back(std::move(set));
         lining.push_back(own);
@@ -349,17 +362,13 @@ size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, Voxe
     if (!(wallMm < frameDMinMm)) return 0;  // the frame might reach into a prism
     bool isTriple = false;
     const std::vector<TunnelPrism> found =
-        crossingPrisms(field, 2.0 * wallMm, radiusMm, wallMm + field.voxelMm, &isTriple);
-    if (isTriple)
-        context.detail(
-            "mounting: three tunnels cross at one point: their linings are not carved "
-            "(docs/mounting.md, \"What is not done\")");
+        crossingPrisms(field, 2.0 * wallMm, radiusMm, wallMm + field.voxelMm, &isTriple, true);
     if (found.empty()) return 0;
     std::vector<std::shared_ptr<const TunnelPrism>> prisms;
     for (const TunnelPrism& p : found) prisms.push_back(std::make_shared<const TunnelPrism>(p));
-    const std::vector<uint32_t> prismOf = prismOwners(field, found);
+    const std::vector<uint32_t> prismOf = prismOwners(field, found, isTriple);
     const size_t oldCount = pieces.size();
-    const size_t carved = carveParts(pieces, sets, field, prisms, prismOf).size();
+    const size_t carved = carveParts(pieces, sets, field, prisms, prismOf, isTriple).size();
     if (carved == 0) return 0;
     for (size_t p = 0; p < oldCount; ++p)
         for (const auto& prism : prisms) sets[p].prisms.push_back({prism, false});
@@ -371,6 +380,20 @@ size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, Voxe
     for (size_t p = 0; p < pieces.size(); ++p) isLining[p] = sets[p].isLining ? 1 : 0;
     ownBand(field, prismOf, isLining);
     const size_t joined = joinRemnants(pieces, sets, field, cells, minPieceVolumeMm3);
+    if (isTriple) {
+        cutStaves(pieces, sets, field);
+        dropEmptyPieces(pieces, sets, field);
+        grouping.faces = faceContacts(field, cells, sets, pieces);
+        const size_t staves =
+            size_t(std::count_if(sets.begin(), sets.end(), [](const CellSet& c) { return c.isLining; }));
+        context.detail("mounting: " + std::to_string(found.size()) +
+                       " tunnels cross three at a time; their linings carved into " + std::to_string(carved) +
+                       " pieces along them and cut into " + std::to_string(staves) +
+                       " staves that slide along them and are pushed onto pegs across them (" +
+                       std::to_string(dropped) + " pieces of the partition were all lining, " +
+                       std::to_string(joined) + " small rests joined to neighbours)");
+        return staves;
+    }
     const size_t cuts = cutRings(pieces, sets, field);
     grouping.faces = faceContacts(field, cells, sets, pieces);
     context.detail("mounting: " + std::to_string(found.size()) +

@@ -44,16 +44,14 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
     if (kind !=
         Change::kGroups)  // glued groups leave the pieces and the frame, so the candidates, as they are
         candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
-    out.plan =
-        planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context, preGlued);
+    out.plan = planOverCandidates(out, field, grouping, sweeps, candidates, lost, opt, context, preGlued);
     auto underHeldAfter = [&] {
         return !out.plan.isBuildable() ? SIZE_MAX : steps ? underHeldStepsNow() : underHeldNow();
     };
     size_t after = underHeldAfter();
     if (after == before && refine && refine()) {
         // As many under-held as before: one change more on top, planned and judged with it.
-        out.plan =
-            planOverCandidates(out, field, grouping.faces, sweeps, candidates, lost, opt, context, preGlued);
+        out.plan = planOverCandidates(out, field, grouping, sweeps, candidates, lost, opt, context, preGlued);
         after = underHeldAfter();
     }
     context.debug("mounting: " + what + ": " + (steps ? "steps" : "pieces") + " under " +

@@ -485,6 +485,25 @@ std::vector<TenonCandidate> findTenonCandidates(const zome::Structure& frame,
     return out;
 }
 
+bool stemsMeet(const Tenon& a, const Tenon& b, const TenonOptions& o) {
+    std::vector<Vec3d> ha = tenonHullMm(a, o), hb = tenonHullMm(b, o);
+    ha.resize(8), hb.resize(8);
+    const Vec3d ea[3] = {a.axisGrid, a.longSideGrid, cross(a.axisGrid, a.longSideGrid)};
+    const Vec3d eb[3] = {b.axisGrid, b.longSideGrid, cross(b.axisGrid, b.longSideGrid)};
+    std::vector<Vec3d> axes(ea, ea + 3);
+    axes.insert(axes.end(), eb, eb + 3);
+    for (const Vec3d& x : ea)
+        for (const Vec3d& y : eb)
+            if (const Vec3d n = cross(x, y); norm(n) > 1e-6) axes.push_back(normalized(n));
+    for (const Vec3d& n : axes) {
+        double a0 = 1e300, a1 = -1e300, b0 = 1e300, b1 = -1e300;
+        for (const Vec3d& p : ha) a0 = std::min(a0, dot(p, n)), a1 = std::max(a1, dot(p, n));
+        for (const Vec3d& p : hb) b0 = std::min(b0, dot(p, n)), b1 = std::max(b1, dot(p, n));
+        if (a1 + o.frameClearanceMm < b0 || b1 + o.frameClearanceMm < a0) return false;
+    }
+    return true;
+}
+
 TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, const std::vector<int>& holeOfPiece,
                        const TenonOptions& o) {
     const size_t pieceCount = holeOfPiece.size();
@@ -499,16 +518,22 @@ TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, const std:
         if (p < 0 || size_t(p) >= pieceCount || candidates[i].tenon.hole != holeOfPiece[size_t(p)]) continue;
         if (rejection[i].empty()) byPiece[size_t(p)].push_back(i);
     }
-    std::vector<const Tenon*> chosen;
+    std::vector<const TenonCandidate*> chosen;
     auto endRadius = [&](const Tenon& t) {
         return std::sqrt(2.0) * stemHalfWidthMm(o, t.endMm - t.shoulderMm);
     };
-    auto conflicts = [&](const Tenon& t) {
-        for (const Tenon* c : chosen) {
-            const double minGap = endRadius(t) + endRadius(*c) + o.frameClearanceMm;
+    auto conflicts = [&](const TenonCandidate& x) {
+        const Tenon& t = x.tenon;
+        for (const TenonCandidate* y : chosen) {
+            const Tenon& c = y->tenon;
+            const double minGap = endRadius(t) + endRadius(c) + o.frameClearanceMm;
             if (zome::segmentSegmentDistanceSq(t.pointAt(t.shoulderMm), t.pointAt(t.endMm),
-                                               c->pointAt(c->shoulderMm),
-                                               c->pointAt(c->endMm)) < minGap * minGap)
+                                               c.pointAt(c.shoulderMm),
+                                               c.pointAt(c.endMm)) < minGap * minGap &&
+                // A stave's stem and another out of one ball's holes part from its face: their
+                // round bounds overlap where the stems do not (square to each other, 12.5 mm apart
+                // at the face), and a stave has few balls behind its wall.
+                (!(x.isStave || y->isStave) || c.ball != t.ball || c.hole == t.hole || stemsMeet(t, c, o)))
                 return true;
         }
         return false;
@@ -546,7 +571,7 @@ TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, const std:
             double bestKey = -1e300;
             for (size_t i : byPiece[p]) {
                 if (isTaken[i] || !rejection[i].empty()) continue;
-                if (conflicts(candidates[i].tenon)) {
+                if (conflicts(candidates[i])) {
                     rejection[i] = "another tenon in the way";
                     continue;
                 }
@@ -556,7 +581,7 @@ TenonPlan chooseTenons(const std::vector<TenonCandidate>& candidates, const std:
             if (best == SIZE_MAX) continue;
             isTaken[best] = 1;
             plan.perPiece[p].push_back(candidates[best].tenon);
-            chosen.push_back(&candidates[best].tenon);
+            chosen.push_back(&candidates[best]);
         }
     }
     for (size_t p = 0; p < pieceCount; ++p) {

@@ -174,7 +174,15 @@ struct TenonCandidate {
     int64_t piece = -1;     ///< the piece the ray meets, −1 when it meets none
     std::string rejection;  ///< "hole holds a strut", "too far", "surface too oblique", ...
     double score = 0.0;     ///< larger is better: perpendicular and short
+    /// The piece is a stave (detail/staves.h): its stems and another's out of one ball are tested
+    /// for a meeting as prisms (stemsMeet), not by their round bounds.
+    bool isStave = false;
 };
+
+/// Do the stems of @p a and @p b (their tapered prisms, tenonHullMm's first 8 points) come within
+/// the frame's clearance of each other? Separating axes: each stem's axis and section sides and
+/// their cross products; the slant of the taper makes the test err toward a meeting.
+bool stemsMeet(const Tenon& a, const Tenon& b, const TenonOptions& o);
 
 /// The ray of ball @p id along @p hole: where it meets the wall, which piece, and why it cannot be a
 /// tenon (empty rejection: it can).

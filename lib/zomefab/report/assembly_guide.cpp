@@ -139,7 +139,17 @@ std::vector<std::string> mountingSentences(const MountingStep& step) {
                                            " on " + g.b + " go into its sockets") +
                         ").");
     const Vec3d& d = zome::holeDirection(step.hole);
-    lines.push_back("Approach from: " + zome::directionName(d) +
+    if (step.liftMm > 0) {
+        // A stave: it reaches its place only along its tunnel, held off its pegs.
+        const Vec3d& s = step.slide;
+        lines.push_back(
+            "Slide it into the tunnel from its mouth on the side " + zome::directionName(s) +
+            formatNumbers(" (direction %+.3f, %+.3f, %+.3f)", 0.0 - s[0], 0.0 - s[1], 0.0 - s[2]) +
+            formatNumbers(", held %.0f mm off its place toward the tunnel's middle, pegs toward "
+                          "the wall, until it is over its place; then push it onto its pegs.",
+                          step.liftMm));
+    }
+    lines.push_back((step.liftMm > 0 ? "Push it on from: " : "Approach from: ") + zome::directionName(d) +
                     ". Push: " + zome::directionName(scale(d, -1.0)) +
                     formatNumbers(" (direction %+.3f, %+.3f, %+.3f).", 0.0 - d[0], 0.0 - d[1], 0.0 - d[2]));
     if (step.tenons.empty()) {
@@ -277,6 +287,10 @@ nlohmann::json assemblyGuideToJson(const AssemblyGuide& guide) {
                             {"push", {0.0 - d[0], 0.0 - d[1], 0.0 - d[2]}},
                             {"push_name", zome::directionName(scale(d, -1.0))},
                             {"pegs", std::move(pegs)}});
+        if (m.liftMm > 0) {  // a stave: slid in along its tunnel first, held lift_mm off its place
+            mounting.back()["slide"] = {0.0 - m.slide[0], 0.0 - m.slide[1], 0.0 - m.slide[2]};
+            mounting.back()["lift_mm"] = m.liftMm;
+        }
     }
     return {{"start_balls", std::move(starts)},
             {"layers", guide.layers},

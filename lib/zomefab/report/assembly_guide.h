@@ -60,6 +60,8 @@ struct MountingStep {
     /// Pieces already on that this step's pieces are glued onto as they go on (a: this step's
     /// piece, b: the one already on; the pins stand on b): a step no peg holds.
     std::vector<GlueJoint> gluedOnto;
+    Vec3d slide{0, 0, 0};  ///< a stave's first leg (frame, unit): slid in along −slide
+    double liftMm = 0.0;   ///< then pushed on this far (mm); 0: one straight push
 };
 
 struct AssemblyGuide {

@@ -127,7 +127,9 @@ std::string stepFigure(const Scene& scene, const AssemblyGuide& guide, size_t st
     const double size = norm(box.size());
     const Vec3d head = add(centre, scale(approach, 0.55 * size)),
                 tail = add(centre, scale(approach, 1.05 * size));
-    Picture picture = stepPicture(scene, approach, tail);
+    // A stave is seen from between its slide and its lift, so that both arrows show along.
+    Picture picture =
+        stepPicture(scene, step.liftMm > 0 ? normalized(add(approach, step.slide)) : approach, tail);
     for (const zome::StrutId id : scene.frame.strutIds())
         scene.strut(picture, id, strutColorSrgb(scene.frame.strut(id).color));
     for (const zome::BallId id : scene.frame.ballIds())
@@ -143,8 +145,21 @@ std::string stepFigure(const Scene& scene, const AssemblyGuide& guide, size_t st
     }
     for (const TenonLink& t : step.tenons)
         picture.ring(scene.frame.ball(t.ball).positionMm, 11.0, 3.0, kMark);
-    picture.arrow(tail, head, 5.0, kArrow);
     const std::string name = "Step " + std::to_string(stepIndex + 1);
+    if (step.liftMm > 0) {
+        // A stave: the long arrow along its tunnel to where it is held off its place, the short
+        // one onto its pegs.
+        const Vec3d held = add(centre, scale(approach, step.liftMm + 0.3 * size));
+        picture.arrow(add(held, scale(step.slide, 0.9 * size)), add(held, scale(step.slide, 0.4 * size)), 5.0,
+                      kArrow);
+        picture.arrow(held, add(centre, scale(approach, 0.2 * size)), 4.0, kArrow);
+        return figure(
+            picture, name,
+            name + ": " + mountingTitle(step) +
+                " in colour, slid along its tunnel (the long arrow), then pushed onto its pegs "
+                "(the short one); the balls its pegs go into are ringed; pieces already on are grey.");
+    }
+    picture.arrow(tail, head, 5.0, kArrow);
     return figure(picture, name,
                   name + ": " + mountingTitle(step) +
                       " in colour, pushed on along the arrow; the balls its pegs go "

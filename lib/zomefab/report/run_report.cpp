@@ -138,6 +138,8 @@ std::vector<MountingStep> mountingSteps(const pieces::Pieces& all) {
     for (const mount::MountStep& plan : all.plan.steps) {
         MountingStep step;
         step.hole = plan.hole;
+        step.slide = plan.slide;
+        step.liftMm = plan.liftMm;
         for (uint32_t p : plan.pieces) {
             step.pieces.push_back(pieces::pieceName(all, p));
             for (const pieces::Tenon& t : all.pieces[p].tenons)

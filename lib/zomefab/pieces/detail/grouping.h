@@ -41,6 +41,9 @@ double assignGroups(std::vector<Component>& comps, const VoxelField& field,
 struct CutContact {
     Vec3d normal{0, 0, 1};
     size_t voxelFaces = 0;
+    /// A stave's border, one of the six ways a voxel step goes: it orders its two pieces however
+    /// small (the voxels near it are left out of their sweeps, as near any large face).
+    bool isStaveBorder = false;
 };
 /// The cut faces between pieces: for the pieces (a, b), a < b, one entry per plane they share,
 /// the plane between a cell of a and a cell of b, or a plane one was re-cut along; where two pieces

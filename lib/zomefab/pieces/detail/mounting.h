@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "zomefab/mount/plan.h"
 #include "zomefab/mount/sweep.h"
 #include "zomefab/pieces/detail/grouping.h"
+#include "zomefab/pieces/detail/staves.h"
 #include "zomefab/pieces/detail/voxels.h"
 #include "zomefab/pieces/pieces.h"
 #include "zomefab/zome/structure.h"
@@ -119,6 +121,9 @@ struct PlannerInput {
     /// Where no order exists, glue stuck bodies in each other's way into one and plan again (a few
     /// rounds). Off: such a plan is returned stuck at once (a trial that only wants a better plan).
     bool isGluingStuck = true;
+    /// Per piece, the stave it is (detail/prisms.h): staves go on first, in their order, along two
+    /// legs; never glued. Empty: no piece is one.
+    std::vector<std::optional<Stave>> staves;
 };
 PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
                           const std::vector<TenonCandidate>& candidates);
@@ -135,6 +140,24 @@ void testPaths(MountBody& body, const FrameSweeps& sweeps, double voxelMm, size_
 /// tested against the frame as testPaths does.
 MountBody makeBody(const std::vector<uint32_t>& members, const PlannerInput& input, const FrameSweeps& sweeps,
                    double voxelMm, int maxPerPiece, size_t freeWanted = 0);
+
+/// The body of stave piece @p p (PlannerInput::staves) with its one direction: the hole of most
+/// tenons (then score) that isStaveDirection allows; −1 when no such hole has a tenon.
+MountBody staveBody(uint32_t p, const PlannerInput& input, const Transform4d& frameToGridMm, int maxPerPiece,
+                    int* hole);
+
+/// The steps of @p staves (pieces, in their order; @p holes their directions, −1: none) put before
+/// @p plan's, each slid in along its tunnel and held kStaveLiftMm off its place; a stave with no
+/// direction is a problem of the plan instead.
+void addStaveSteps(mount::InstallationPlan& plan, const PlannerInput& input,
+                   const std::vector<uint32_t>& staves, const std::vector<int>& holes,
+                   const Transform4d& frameToGridMm);
+
+/// The plan when staves have no direction (−1 in @p holes): the staves' steps and a problem for each
+/// stave no hole holds; every other piece placed nowhere (no order is sought for them: the frame
+/// must grow toward the staves first).
+mount::InstallationPlan unheldStavesPlan(const PlannerInput& input, const std::vector<uint32_t>& staves,
+                                         const std::vector<int>& holes, const Transform4d& frameToGridMm);
 
 /// Hole @p hole's direction in the grid's mm (unit).
 Vec3d gridDirection(int hole, const Transform4d& frameToGridMm);
@@ -185,9 +208,11 @@ struct GlueOnRule {
 /// then the highest). A hosted body (MountBody::glueOptions) goes on along a free direction while a
 /// body it can be glued onto (@p glueOn) is in place; hosted bodies leave first, so they go on as
 /// late as they can. Bodies with no direction at all take no part (Disassembly::holes −1).
+/// The last @p fixedCount bodies are in place throughout (staves, put on first): in every other
+/// body's way where they are, never taken away, neither placed nor stuck.
 Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts& faces,
                         const Transform4d& frameToGridMm, double voxelMm, const GlueOnRule& glueOn,
-                        SweepCache& cache, const RunContext& context);
+                        SweepCache& cache, const RunContext& context, size_t fixedCount = 0);
 
 /// Voxel faces between the pieces of two bodies (their contact area, in voxel faces).
 size_t bodyContact(const MountBody& a, const MountBody& b, const FaceContacts& faces);

@@ -14,6 +14,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <tuple>
 #include <vector>
 
 #include "zomefab/core/run_context.h"
@@ -38,6 +40,11 @@ struct TunnelPrism {
     double loMm = 0.0, hiMm = 0.0;  ///< its ends along the axis (grid mm)
     double voxelMm = 1.0;
     Vec3d originMm{0, 0, 0};  ///< grid mm of voxel index (0, 0, 0)
+    /// Its lining is cut into staves (three tunnels cross at one point): a later axis keeps the
+    /// shell where prisms overlap.
+    bool isStaved = false;
+    double centerUMm = 0.0, centerVMm = 0.0;  ///< the core's middle across the axis (grid mm)
+    double coreRadiusMm = 0.0;                ///< half the core's extent across the axis
 
     /// The core distance of column (u, v); a far value off the raster.
     double columnDistanceMm(int u, int v) const;
@@ -54,15 +61,18 @@ TunnelPrism tunnelPrism(const TunnelCore& core, const VoxelField& field, double 
                         double hiMm);
 
 /// Which prism each slot of @p field lies in: of the prisms holding it, the one of the earliest axis
-/// (then the lowest index); kNone for none. Per slot, band included.
-std::vector<uint32_t> prismOwners(const VoxelField& field, const std::vector<TunnelPrism>& prisms);
+/// (the latest with @p isLaterFirst; then the lowest index); kNone for none. Per slot, band included.
+std::vector<uint32_t> prismOwners(const VoxelField& field, const std::vector<TunnelPrism>& prisms,
+                                  bool isLaterFirst = false);
 
 /// The prisms of the tunnels of @p field that cross (tunnelCores at least @p minDiameterMm across,
 /// coresCross), each @p radiusMm round its core and ending @p endMm inside the object's voxels along
-/// its lines (the mouth's own shell stays with the pieces round it). Empty when no two cross, or
-/// when three cross at one point (@p isTriple is then set).
+/// its lines (the mouth's own shell stays with the pieces round it). Empty when no two cross.
+/// Where three cross at one point @p isTriple is set, and the prisms are staved ones (isStaved,
+/// ending at the object's last voxels: the staves slide out through the mouths) with
+/// @p isStaving, else none.
 std::vector<TunnelPrism> crossingPrisms(const VoxelField& field, double minDiameterMm, double radiusMm,
-                                        double endMm, bool* isTriple);
+                                        double endMm, bool* isTriple, bool isStaving = false);
 
 /// The linings of crossing tunnels carved out of the pieces (see the file's comment): every inside
 /// voxel of a prism goes to a new piece, one per connected part of the voxels a prism owns (parts
@@ -72,7 +82,10 @@ std::vector<TunnelPrism> crossingPrisms(const VoxelField& field, double minDiame
 /// under @p minPieceVolumeMm3 joins a neighbour. Then every lining is cut across its axis into equal
 /// rings no longer than kTunnelSlabMm and the face contacts are made again. Prisms of radius
 /// @p wallMm plus two voxels; nothing is carved unless the wall is under @p frameDMinMm. Returns how
-/// many pieces line the tunnels (0: nothing changed).
+/// many pieces line the tunnels (0: nothing changed). Where three tunnels cross at one point the
+/// prisms are staved: a later axis keeps the shell where they overlap, each lining is cut at its
+/// tunnel's middle, into rings, and each ring into four staves by planes along the axis at ±√½ of
+/// the core's radius across u and at the middle across v (Stave).
 size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
                             const GridCells& cells, double wallMm, double frameDMinMm,
                             double minPieceVolumeMm3, const RunContext& context);

@@ -38,7 +38,7 @@ std::vector<const TenonCandidate*> usableCandidates(const std::vector<TenonCandi
 /// of @p preGlued are glued into one body before planning (PlannerInput::preGlued), and then no
 /// stuck bodies are glued (a trial of glueUnderHeld).
 mount::InstallationPlan planOverCandidates(const Pieces& out, const VoxelField& field,
-                                           const FaceContacts& faces, const FrameSweeps& sweeps,
+                                           const Grouping& grouping, const FrameSweeps& sweeps,
                                            std::vector<TenonCandidate>& candidates,
                                            std::set<std::pair<zome::BallId, int>>& lost,
                                            const PiecesOptions& opt, const RunContext& context,
@@ -153,6 +153,13 @@ private:
         std::optional<zome::Structure> frame;  ///< kFrame changes only
     };
 };
+
+/// Where the plan places staves nowhere (no hole behind a stave's wall holds it): struts to new
+/// balls whose holes along a direction the stave may take (isStaveDirection, the nearest its lift
+/// first) are its tenon candidates, up to --min-tenons per stave, found as growFrameForPieces
+/// finds them; kept when the plan made again can be carried out. Not where more than a few tunnels'
+/// staves are unheld (kMaxStavesToGrow). Returns how many struts were kept.
+size_t growFrameForStaves(Replanner& r, const StrutTest& canGrow);
 
 /// Grows the frame toward the pieces fewer than minPerPiece pegs hold along their planned direction
 /// (docs/mounting.md, "Frame grown toward a piece"): for each, the strut (from any ball, any hole and

@@ -72,6 +72,9 @@ struct CellSet {
     std::vector<PrismBound> prisms;
     /// A lining carved along a prism: its cells do not bound it, only its prisms and half-spaces.
     bool isLining = false;
+    /// A stave's ring (a staved prism's lining): how far its far end lies from the mouth it slides
+    /// out of (mm), which orders the rings along the tunnel (detail/prisms.h, Stave).
+    double ringDepthMm = 0.0;
 };
 
 /// δ_P: a signed distance to the region of the piece's cells (negative inside), from the planes

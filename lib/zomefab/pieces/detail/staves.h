@@ -1,0 +1,88 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file Staves (internal to lib/zomefab/pieces): where three tunnels cross at one point, each
+/// tunnel's lining, carved along its prism (detail/prisms.h) with a later axis keeping the shell
+/// where prisms overlap, is cut into rings and each ring into four staves. A stave reaches its place
+/// only along its tunnel: it slides in held off its wall toward the axis, then is pushed onto pegs
+/// of balls behind the wall (mount::MountStep's two legs). docs/mounting.md, "Three tunnels through
+/// one point".
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <tuple>
+#include <vector>
+
+#include "zomefab/core/vec.h"
+#include "zomefab/pieces/detail/prisms.h"
+#include "zomefab/pieces/detail/voxels.h"
+#include "zomefab/pieces/pieces.h"
+
+namespace zomefab::pieces::detail {
+
+/// A stave: a piece of the lining of a tunnel that crosses two others at one point. Its place is
+/// reached only along its tunnel, out of the nearer mouth, held off its wall toward the axis, and it
+/// is then pushed onto pegs of balls behind the wall (docs/mounting.md, "Three tunnels through one
+/// point"). Staves go on before every other piece: x tunnels' first, then y's, then z's (each later
+/// axis keeps the shell where prisms overlap, so a stave's way meets only staves of its own
+/// tunnel), along a tunnel the deepest first, in a ring the side staves (across u) first.
+struct Stave {
+    Vec3d slideGrid{0, 0, 0};  ///< unit, along the axis: the way it slides off, out of its mouth
+    Vec3d liftGrid{0, 0, 0};   ///< unit, across the axis and out of it: the way it is pushed on
+    Vec3d seamGrid{0, 0,
+                   0};    ///< unit, across the axis: the normal of the seams between side staves and the rest
+    bool isSide = false;  ///< a side stave (beyond the seams across seamGrid), else top or bottom
+    /// The mounting order, lowest first: axis, tunnel (its core's middle), mouth, −depth from the
+    /// mouth, side (0) or top and bottom (1), then the lift's sign.
+    std::tuple<int, double, double, double, double, int, double> rank;
+};
+
+/// Rings of staves are no longer than this (mm): long enough that a ring round a crossing, whose
+/// ridges alone are narrow, takes wall behind which balls lie; short enough for a printer's bed.
+inline constexpr double kStaveRingMm = 160.0;
+
+/// Whether a stave may take the direction @p d (grid, unit; the hole's, toward the tunnel's axis):
+/// within 35° of its lift reversed, leaning only along the axis and not back toward the deeper
+/// rings, which are on. Leaning round the axis, its lift (up to a stem's length) would carry a top
+/// stave across its seams into the side staves, which are on, and a side stave's edges out of the
+/// prism past the corners, into the frame.
+bool isStaveDirection(const Stave& stave, const Vec3d& d);
+
+/// After a plan that cannot be carried out: when staves (@p sets) are placed nowhere, the plan's
+/// first problem says how many and why, and Pieces::crossingTunnelPieces is set (another partition
+/// leaves the same tunnels and the same frame behind them). Returns how many.
+size_t noteUnheldStaves(Pieces& out, const std::vector<CellSet>& sets);
+
+/// How many staves (@p sets) a plan places nowhere (@p holeOfPiece −1).
+size_t unheldStaves(const std::vector<int>& holeOfPiece, const std::vector<CellSet>& sets);
+
+/// Whether @p set's piece lines a staved prism: a stave, which no re-cut may cut across its seams.
+bool isStaveSet(const CellSet& set);
+
+/// The stave @p set's piece is (its voxels' centres @p voxelsMm, grid mm), or none for a piece that
+/// lines no staved prism.
+std::optional<Stave> staveOf(const CellSet& set, const std::vector<Vec3d>& voxelsMm);
+
+/// The prism a lining's cell set keeps inside, or null.
+const TunnelPrism* ownPrism(const CellSet& set);
+
+/// Every lining of a staved prism cut at its tunnel's middle (each half slides out of its own
+/// mouth), each half into equal rings no longer than kStaveRingMm, each ring into four staves:
+/// across u at ±√½ of the core's radius (the side staves, whose seams are across their lift), then
+/// across v at the middle (top and bottom, sliding along the side staves' seams as they are lifted).
+/// Sets each ring's depth (CellSet::ringDepthMm). Returns how many cuts; pieces the cuts left empty
+/// are the caller's to drop.
+size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field);
+
+/// How far a stave is held off its place while it slides (mm) before its tenons are known: its
+/// pegs' depth (4 mm) and as much again (setStaveLifts makes it longer).
+inline constexpr double kStaveLiftMm = 8.0;
+
+/// Each stave's lift (the plan's steps of two legs) once its tenons are known: held that far off
+/// its place along its direction, every peg's tip lies at least 2 mm shallower under its wall than
+/// the frame may come (@p frameDMinMm), so its stems slide along the tunnel past no ball and no
+/// strut. Depth is taken across the wall (the grid axis across the slide nearest the direction),
+/// from the stave's voxel nearest the tunnel's axis (a voxel's half under the surface).
+void setStaveLifts(Pieces& out, const VoxelField& field, const Transform4d& frameToGridMm,
+                   double frameDMinMm);
+
+}  // namespace zomefab::pieces::detail

@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// @file Staves where three tunnels cross at one point (docs/mounting.md, "Three tunnels through one
+/// point"): a stave slides out of its nearer mouth and is lifted across its axis, it takes only
+/// directions that keep its seams and its edges in the prism, and the stave pieces of a carved
+/// cube are cut into rings and four staves each.
+#include "zomefab/pieces/detail/staves.h"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "tunnel_fixtures.h"
+
+using namespace zomefab;
+using namespace zomefab::pieces::detail;
+
+TEST_CASE(
+    "staveOf: a stave slides out of its nearer mouth, is lifted across its axis, and takes only directions "
+    "that keep its seams") {
+    const VoxelField three = cubeWithTunnels(64, 10.0, {0, 1, 2}, 4.0);
+    bool isTriple = false;
+    const std::vector<TunnelPrism> prisms = crossingPrisms(three, 8.0, 6.0, 5.0, &isTriple, true);
+    REQUIRE(prisms.size() == 3);
+    CellSet set;
+    set.isLining = true;
+    set.ringDepthMm = 20.0;
+    set.prisms.push_back({std::make_shared<const TunnelPrism>(prisms[0]), true});  // along x: u = y, v = z
+    // Voxels on the tunnel's top (+z), near the high-x mouth.
+    const std::vector<Vec3d> top{{50, 31.5, 43}, {55, 33, 43}, {52, 30, 44}};
+    const std::optional<Stave> st = staveOf(set, top);
+    REQUIRE(st.has_value());
+    CHECK(st->slideGrid[0] == 1.0);
+    CHECK(st->liftGrid[2] == 1.0);
+    CHECK_FALSE(st->isSide);
+    CHECK(std::get<4>(st->rank) == doctest::Approx(-20.0));
+    // Its hole points down toward the axis; tilted toward its mouth by 20° it may be, back toward
+    // the deeper staves or across its seams (along y) not.
+    const double c = std::cos(20.0 * kPi / 180.0), s = std::sin(20.0 * kPi / 180.0);
+    CHECK(isStaveDirection(*st, {0, 0, -1}));
+    CHECK(isStaveDirection(*st, {s, 0, -c}));
+    CHECK_FALSE(isStaveDirection(*st, {-s, 0, -c}));
+    CHECK_FALSE(isStaveDirection(*st, {0, s, -c}));
+    CHECK_FALSE(isStaveDirection(*st, {0, 0, 1}));
+    // A side stave (on −y, near the low-x mouth): the same.
+    const std::vector<Vec3d> side{{10, 19, 31.5}, {12, 19, 33}, {8, 20, 30}};
+    const std::optional<Stave> sd = staveOf(set, side);
+    REQUIRE(sd.has_value());
+    CHECK(sd->slideGrid[0] == -1.0);
+    CHECK(sd->liftGrid[1] == -1.0);
+    CHECK(sd->isSide);
+    CHECK(isStaveDirection(*sd, {0, 1, 0}));
+    CHECK(isStaveDirection(*sd, {-s, c, 0}));       // toward its mouth (−x here)
+    CHECK_FALSE(isStaveDirection(*sd, {0, c, s}));  // round the axis: its edges past the corners
+    CHECK_FALSE(isStaveDirection(*sd, {s, c, 0}));  // toward the deeper staves (+x here)
+    // A piece of no staved prism is no stave.
+    CellSet plain;
+    CHECK_FALSE(staveOf(plain, top).has_value());
+}
+
+TEST_CASE("cutStaves: a staved lining is cut at its tunnel's middle and each ring into four staves") {
+    VoxelField three = cubeWithTunnels(64, 10.0, {0, 1, 2}, 4.0);
+    bool isTriple = false;
+    const std::vector<TunnelPrism> prisms = crossingPrisms(three, 8.0, 6.0, 5.0, &isTriple, true);
+    REQUIRE(prisms.size() == 3);
+    // The lining the z prism keeps (it keeps every overlap) as piece 0, the rest of the shell piece 1.
+    const std::vector<uint32_t> owner = prismOwners(three, prisms, true);
+    std::vector<zomefab::pieces::Piece> pieces(2);
+    pieces[0].id = 0, pieces[1].id = 1;
+    std::vector<CellSet> sets(2);
+    sets[0].isLining = true;
+    sets[0].prisms.push_back({std::make_shared<const TunnelPrism>(prisms[2]), true});
+    size_t lining = 0;
+    for (size_t s = 0; s < three.owner.size(); ++s)
+        if (three.isInside(s)) three.owner[s] = owner[s] == 2 ? 0 : 1, lining += owner[s] == 2;
+    REQUIRE(lining > 1000);
+    // Two halves of 32 mm, one ring each (under kStaveRingMm), four staves per ring: seven cuts.
+    CHECK(cutStaves(pieces, sets, three) == 7);
+    REQUIRE(pieces.size() == 9);
+    const double c = prisms[2].centerUMm, off = std::sqrt(0.5) * prisms[2].coreRadiusMm;
+    std::vector<std::vector<Vec3d>> voxels(pieces.size());
+    for (size_t s = 0; s < three.owner.size(); ++s)
+        if (three.isInside(s)) voxels[three.owner[s]].push_back(three.world(three.coordOf(s)));
+    size_t sides = 0, tops = 0;
+    for (uint32_t p = 0; p < pieces.size(); ++p) {
+        if (p == 1) continue;
+        REQUIRE(!voxels[p].empty());
+        CHECK(isStaveSet(sets[p]));
+        const std::optional<Stave> st = staveOf(sets[p], voxels[p]);
+        REQUIRE(st.has_value());
+        CHECK(sets[p].ringDepthMm == doctest::Approx(32.0).epsilon(0.05));  // a half's far end: the middle
+        // Every voxel of a stave lies on its own side of the half (z) and of the seams (x at ±off).
+        const double slide = st->slideGrid[2];
+        for (const Vec3d& x : voxels[p]) {
+            CHECK((x[2] - 31.5) * slide >= -0.5);
+            if (st->isSide)
+                CHECK((x[0] - c) * st->liftGrid[0] >= off - 1e-9);
+            else
+                CHECK(std::abs(x[0] - c) <= off + 1e-9);
+        }
+        (st->isSide ? sides : tops) += 1;
+    }
+    CHECK(sides == 4);
+    CHECK(tops == 4);
+}
