@@ -249,8 +249,9 @@ std::string crossingTunnelNote(const CrossingTunnels& tunnels, const std::vector
            std::to_string(tunnels.crossings) + (tunnels.crossings == 1 ? " pair" : " pairs") +
            " of them crossing): such a piece can reach its place only through the tunnels, and "
            "zomefab lines a tunnel with rings that slide in along it where no other tunnel crosses it "
-           "or where tunnels cross two at a time, not where three meet at one point (docs/mounting.md, "
-           "\"What is not done\"), so partitioning again does not help";
+           "or where tunnels cross two at a time, and with staves where three meet at one point, and "
+           "these were not placed (docs/mounting.md, \"Tunnels that cross\"), so partitioning again "
+           "does not help";
 }
 
 size_t crossingTunnelLining(const Pieces& out, const VoxelField& field, double wallMm, std::string* note,

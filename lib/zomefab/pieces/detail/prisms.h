@@ -6,9 +6,9 @@
 /// ball and no strut. Where two prisms overlap the earlier axis (x, then y, then z) keeps the shell, so its
 /// lining runs through the crossing unbroken and goes on as glued rings, and the other tunnel's
 /// segments end against it with faces across their own axis, each glued onto a ring at its far
-/// end. Three tunnels through one point are not carved: there no lining at all crosses the
-/// crossing's middle, and glue alone cannot hold every segment (docs/mounting.md, "Tunnels that
-/// cross").
+/// end (docs/mounting.md, "Tunnels that cross"). Where three tunnels cross at one point no lining
+/// crosses the crossing's middle and glue alone cannot hold every segment: there the prisms are
+/// staved, a later axis keeps every overlap, and the linings are cut into staves (detail/staves.h).
 #pragma once
 
 #include <cstddef>
