@@ -150,6 +150,22 @@ double TunnelPrism::signedDistanceMm(const Vec3d& x) const {
     return std::max({d - radiusMm, loMm - t, t - hiMm});
 }
 
+const TunnelPrism* ownPrism(const CellSet& set) {
+    for (const CellSet::PrismBound& b : set.prisms)
+        if (b.isInside) return b.prism.get();
+    return nullptr;
+}
+
+std::pair<double, double> extentAlong(const VoxelField& field, const std::vector<size_t>& slots, int a) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (size_t s : slots)
+        if (field.isInside(s)) {
+            const double t = field.world(field.coordOf(s))[size_t(a)];
+            lo = std::min(lo, t), hi = std::max(hi, t);
+        }
+    return {lo, hi};
+}
+
 TunnelPrism tunnelPrism(const TunnelCore& core, const VoxelField& field, double radiusMm, double loMm,
                         double hiMm) {
     TunnelPrism p;
@@ -332,16 +348,11 @@ size_t cutRings(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelFie
     const std::vector<std::vector<size_t>> slots = slotsOfPieces(field, pieces.size());
     size_t cuts = 0;
     for (uint32_t p = 0; p < slots.size(); ++p) {
-        if (!sets[p].isLining) continue;
+        const TunnelPrism* prism = sets[p].isLining ? ownPrism(sets[p]) : nullptr;
+        if (!prism) continue;
         Vec3d axis{0, 0, 0};
-        for (const CellSet::PrismBound& b : sets[p].prisms)
-            if (b.isInside) axis[size_t(b.prism->axis)] = 1.0;
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (size_t s : slots[p])
-            if (field.isInside(s)) {
-                const double t = dot(axis, field.world(field.coordOf(s)));
-                lo = std::min(lo, t), hi = std::max(hi, t);
-            }
+        axis[size_t(prism->axis)] = 1.0;
+        const auto [lo, hi] = extentAlong(field, slots[p], prism->axis);
         const int rings = int(std::ceil((hi - lo) / kTunnelSlabMm));
         uint32_t rest = p;
         for (int k = 1; k < rings; ++k)

@@ -12,27 +12,6 @@
 
 namespace zomefab::pieces::detail {
 
-namespace {
-
-/// The extent of @p slots' inside voxels along grid axis @p a (mm): lowest and highest centre.
-std::pair<double, double> extentAlong(const VoxelField& field, const std::vector<size_t>& slots, int a) {
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (size_t s : slots)
-        if (field.isInside(s)) {
-            const double t = field.world(field.coordOf(s))[size_t(a)];
-            lo = std::min(lo, t), hi = std::max(hi, t);
-        }
-    return {lo, hi};
-}
-
-}  // namespace
-
-const TunnelPrism* ownPrism(const CellSet& set) {
-    for (const CellSet::PrismBound& b : set.prisms)
-        if (b.isInside) return b.prism.get();
-    return nullptr;
-}
-
 size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field) {
     std::vector<std::vector<size_t>> slots = slotsOfPieces(field, pieces.size());
     size_t cuts = 0;

@@ -74,6 +74,12 @@ std::vector<uint32_t> prismOwners(const VoxelField& field, const std::vector<Tun
 std::vector<TunnelPrism> crossingPrisms(const VoxelField& field, double minDiameterMm, double radiusMm,
                                         double endMm, bool* isTriple, bool isStaving = false);
 
+/// The prism a lining's cell set keeps inside, or null.
+const TunnelPrism* ownPrism(const CellSet& set);
+
+/// The extent of @p slots' inside voxels along grid axis @p a (mm): lowest and highest centre.
+std::pair<double, double> extentAlong(const VoxelField& field, const std::vector<size_t>& slots, int a);
+
 /// The linings of crossing tunnels carved out of the pieces (see the file's comment): every inside
 /// voxel of a prism goes to a new piece, one per connected part of the voxels a prism owns (parts
 /// under a cubic centimetre stay with their piece); pieces left with no voxels are dropped and the

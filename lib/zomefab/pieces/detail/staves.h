@@ -62,9 +62,6 @@ bool isStaveSet(const CellSet& set);
 /// lines no staved prism.
 std::optional<Stave> staveOf(const CellSet& set, const std::vector<Vec3d>& voxelsMm);
 
-/// The prism a lining's cell set keeps inside, or null.
-const TunnelPrism* ownPrism(const CellSet& set);
-
 /// Every lining of a staved prism cut at its tunnel's middle (each half slides out of its own
 /// mouth), each half into equal rings no longer than kStaveRingMm, each ring into four staves:
 /// across u at ±√½ of the core's radius (the side staves, whose seams are across their lift), then
