@@ -58,24 +58,38 @@ TEST_CASE(
     CHECK_FALSE(staveOf(plain, top).has_value());
 }
 
-TEST_CASE("cutStaves: a staved lining is cut at its tunnel's middle and each ring into four staves") {
+/// The cube with three tunnels crossing, the lining the z prism keeps (it keeps every overlap) as
+/// piece 0 and the rest of the shell as piece 1.
+struct ZLining {
     VoxelField three = cubeWithTunnels(64, 10.0, {0, 1, 2}, 4.0);
-    bool isTriple = false;
-    const std::vector<TunnelPrism> prisms = crossingPrisms(three, 8.0, 6.0, 5.0, &isTriple, true);
-    REQUIRE(prisms.size() == 3);
-    // The lining the z prism keeps (it keeps every overlap) as piece 0, the rest of the shell piece 1.
-    const std::vector<uint32_t> owner = prismOwners(three, prisms, true);
-    std::vector<zomefab::pieces::Piece> pieces(2);
-    pieces[0].id = 0, pieces[1].id = 1;
-    std::vector<CellSet> sets(2);
-    sets[0].isLining = true;
-    sets[0].prisms.push_back({std::make_shared<const TunnelPrism>(prisms[2]), true});
-    size_t lining = 0;
-    for (size_t s = 0; s < three.owner.size(); ++s)
-        if (three.isInside(s)) three.owner[s] = owner[s] == 2 ? 0 : 1, lining += owner[s] == 2;
+    std::vector<TunnelPrism> prisms;
+    std::vector<zomefab::pieces::Piece> pieces = std::vector<zomefab::pieces::Piece>(2);
+    std::vector<CellSet> sets = std::vector<CellSet>(2);
+    size_t lining = 0;  ///< its inside voxels
+
+    ZLining() {
+        bool isTriple = false;
+        prisms = crossingPrisms(three, 8.0, 6.0, 5.0, &isTriple, true);
+        REQUIRE(prisms.size() == 3);
+        const std::vector<uint32_t> owner = prismOwners(three, prisms, true);
+        pieces[0].id = 0, pieces[1].id = 1;
+        sets[0].isLining = true;
+        sets[0].prisms.push_back({std::make_shared<const TunnelPrism>(prisms[2]), true});
+        for (size_t s = 0; s < three.owner.size(); ++s)
+            if (three.isInside(s)) three.owner[s] = owner[s] == 2 ? 0 : 1, lining += owner[s] == 2;
+    }
+};
+
+TEST_CASE("cutStaves: a staved lining is cut at its tunnel's middle and each ring into four staves") {
+    ZLining z;
+    VoxelField& three = z.three;
+    const std::vector<TunnelPrism>& prisms = z.prisms;
+    std::vector<zomefab::pieces::Piece>& pieces = z.pieces;
+    std::vector<CellSet>& sets = z.sets;
+    const size_t lining = z.lining;
     REQUIRE(lining > 1000);
     // Two halves of 32 mm, one ring each (under kStaveRingMm), four staves per ring: seven cuts.
-    CHECK(cutStaves(pieces, sets, three) == 7);
+    CHECK(cutStaves(pieces, sets, three, 20.0) == 7);  // 64 mm: longer than a mouth ring
     REQUIRE(pieces.size() == 9);
     const double c = prisms[2].centerUMm, off = std::sqrt(0.5) * prisms[2].coreRadiusMm;
     std::vector<std::vector<Vec3d>> voxels(pieces.size());
@@ -102,4 +116,18 @@ TEST_CASE("cutStaves: a staved lining is cut at its tunnel's middle and each rin
     }
     CHECK(sides == 4);
     CHECK(tops == 4);
+}
+
+TEST_CASE("cutStaves: a lining at a mouth no longer than a mouth ring stays one ring") {
+    ZLining z;
+    std::vector<CellSet>& sets = z.sets;
+    // The z lining runs from mouth to mouth, 63 mm between its voxels' centres: under 70 mm.
+    CHECK(cutStaves(z.pieces, sets, z.three, 70.0) == 0);
+    REQUIRE(z.pieces.size() == 2);
+    CHECK(sets[0].isMouthRing);
+    CHECK(sets[0].ringDepthMm == doctest::Approx(63.0).epsilon(0.05));
+    CHECK(isStavedLining(sets[0]));
+    CHECK_FALSE(isStaveSet(sets[0]));
+    CHECK_FALSE(staveOf(sets[0], {Vec3d{31.5, 31.5, 31.5}}).has_value());
+    CHECK_FALSE(isStavedLining(sets[1]));
 }

@@ -264,7 +264,7 @@ FaceContacts faceContacts(const VoxelField& field, const GridCells& cells, const
     // kept apart by the way the voxel step goes (one of six), so no mean normal points along a
     // way that runs into it.
     std::vector<uint8_t> isStave(sets.size(), 0);
-    for (size_t p = 0; p < sets.size(); ++p) isStave[p] = isStaveSet(sets[p]) ? 1 : 0;
+    for (size_t p = 0; p < sets.size(); ++p) isStave[p] = isStavedLining(sets[p]) ? 1 : 0;
     std::map<std::tuple<uint32_t, uint32_t, uint32_t, uint32_t, int>, std::pair<size_t, Vec3d>> counts;
     forEachForwardPair(field, [&](size_t a, size_t b) {
         if (!field.isInside(a) || !field.isInside(b) || field.owner[a] == field.owner[b]) return;

@@ -21,10 +21,9 @@ namespace {
 /// Rounds of growth (each a plan): a piece with no peg can gain one ball per round and needs two.
 constexpr int kGrowRounds = 3;
 
-/// The frame grows toward at most this many staves no peg holds (a few tunnels' worth: the cube
-/// with three tunnels had 2). Each search tries every hole of every ball (bestGrowth), and where
-/// hundreds are unheld (the cheese at 700 mm: 793 of 998) one round cannot hold them all.
-constexpr size_t kMaxStavesToGrow = 48;
+/// Rounds of growth toward staves no peg holds (each a plan, quick while any stays unheld): a ball
+/// grown for one stave may take the spot or the hole another needed.
+constexpr int kStaveGrowRounds = 4;
 
 /// A strut to add: from ball a through hole, of size; the candidate its new ball gives the piece.
 struct Growth {
@@ -138,27 +137,18 @@ std::vector<Growth> growthsFor(const zome::Structure& frame, uint32_t p, size_t 
     return {};
 }
 
-}  // namespace
-
-size_t growFrameForStaves(Replanner& r, const StrutTest& canGrow) {
-    if (!canGrow || r.out.plan.isBuildable()) return 0;
-    if (const size_t unheld = unheldStaves(r.out.plan.holeOfPiece, r.grouping.cellSets);
-        unheld > kMaxStavesToGrow) {
-        r.context.debug("mounting: " + std::to_string(unheld) +
-                        " staves no peg holds: too many to grow the frame toward");
-        return 0;
-    }
+/// Struts added to @p trial toward every stave the plan places nowhere: along the directions it
+/// may take (isStaveDirection), the nearest its lift reversed first, up to --min-tenons each.
+/// Returns how many.
+size_t growTowardStaves(const Replanner& r, const StrutTest& canGrow, zome::Structure& trial) {
     const std::vector<Box3d> boxes = pieceBoxes(r.field, r.out.pieces.size());
     const PlannerInput input = plannerInput(r.out, r.field, r.candidates);
     const size_t minPegs = size_t(std::max(1, r.opt.tenons.minPerPiece));
-    zome::Structure trial = r.frame;
-    size_t added = 0, unheld = 0;
+    size_t added = 0;
     for (uint32_t p = 0; p < r.out.pieces.size(); ++p) {
         if (r.out.plan.holeOfPiece[p] >= 0 || boxes[p].isEmpty()) continue;
         const std::optional<Stave> st = staveOf(r.grouping.cellSets[p], input.pieces[p].voxels);
         if (!st) continue;
-        ++unheld;
-        // The directions it may take, the nearest to its lift reversed first.
         std::vector<std::pair<double, int>> holes;
         for (int h = 0; h < zome::kHoleCount; ++h)
             if (const Vec3d d = gridDirection(h, r.frameToGridMm); isStaveDirection(*st, d))
@@ -171,16 +161,31 @@ size_t growFrameForStaves(Replanner& r, const StrutTest& canGrow) {
             if (!list.empty()) break;
         }
     }
-    r.context.debug("mounting: growing the frame: " + std::to_string(added) + " strut(s) found for " +
-                    std::to_string(unheld) + " stave(s) no peg holds");
-    if (added == 0) return 0;
-    const std::optional<size_t> kept = r.tryChange(
-        [&] { r.frame = std::move(trial); }, SIZE_MAX,
-        "frame grown by " + std::to_string(added) + " struts toward staves", Replanner::Change::kFrame);
-    if (!kept) return 0;
-    r.context.detail("the frame grew by " + std::to_string(added) +
-                     " strut(s), each to a new ball, toward staves no peg held");
     return added;
+}
+
+}  // namespace
+
+size_t growFrameForStaves(Replanner& r, const StrutTest& canGrow) {
+    size_t grown = 0;
+    for (int round = 0; round < kStaveGrowRounds && canGrow && !r.out.plan.isBuildable(); ++round) {
+        r.context.throwIfCancelled();
+        const size_t before = unheldStaves(r.out.plan.holeOfPiece, r.grouping.cellSets);
+        if (before == 0) break;
+        zome::Structure trial = r.frame;
+        const size_t added = growTowardStaves(r, canGrow, trial);
+        r.context.debug("mounting: growing the frame: " + std::to_string(added) + " strut(s) found for " +
+                        std::to_string(before) + " stave(s) no peg holds");
+        if (added == 0 || !r.tryChange([&] { r.frame = std::move(trial); }, before,
+                                       "frame grown by " + std::to_string(added) + " struts toward staves",
+                                       Replanner::Change::kStaves))
+            break;
+        grown += added;
+    }
+    if (grown > 0)
+        r.context.detail("the frame grew by " + std::to_string(grown) +
+                         " strut(s), each to a new ball, toward staves no peg held");
+    return grown;
 }
 
 size_t growFrameForPieces(Replanner& r, const StrutTest& canGrow) {

@@ -11,6 +11,7 @@
 
 #include "zomefab/core/format.h"
 #include "zomefab/pieces/detail/merges.h"
+#include "zomefab/pieces/detail/staves.h"
 
 namespace zomefab::pieces::detail {
 
@@ -46,6 +47,7 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
         candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
     out.plan = planOverCandidates(out, field, grouping, sweeps, candidates, lost, opt, context, preGlued);
     auto underHeldAfter = [&] {
+        if (kind == Change::kStaves) return unheldStaves(out.plan.holeOfPiece, grouping.cellSets);
         return !out.plan.isBuildable() ? SIZE_MAX : steps ? underHeldStepsNow() : underHeldNow();
     };
     size_t after = underHeldAfter();
@@ -54,8 +56,11 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
         out.plan = planOverCandidates(out, field, grouping, sweeps, candidates, lost, opt, context, preGlued);
         after = underHeldAfter();
     }
-    context.debug("mounting: " + what + ": " + (steps ? "steps" : "pieces") + " under " +
-                  std::to_string(opt.tenons.minPerPiece) + " pegs " + std::to_string(before) + " -> " +
+    context.debug("mounting: " + what + ": " +
+                  (kind == Change::kStaves ? std::string("staves placed nowhere")
+                                           : (steps ? "steps" : "pieces") + std::string(" under ") +
+                                                 std::to_string(opt.tenons.minPerPiece) + " pegs") +
+                  " " + std::to_string(before) + " -> " +
                   (after == SIZE_MAX ? std::string("no plan") : std::to_string(after)) + " in " +
                   formatNumber(clock.seconds(), 3) + " s");
     // kMorePieces: more pieces held (pieces less under-held ones), and no more under-held;

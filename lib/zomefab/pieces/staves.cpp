@@ -12,7 +12,8 @@
 
 namespace zomefab::pieces::detail {
 
-size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field) {
+size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field,
+                 double maxMouthRingMm) {
     std::vector<std::vector<size_t>> slots = slotsOfPieces(field, pieces.size());
     size_t cuts = 0;
     auto split = [&](uint32_t p, const Vec3d& normal, double offsetMm) {
@@ -31,6 +32,13 @@ size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelFi
         Vec3d axis{0, 0, 0}, u{0, 0, 0}, v{0, 0, 0};
         axis[size_t(a)] = 1.0, u[size_t(a + 1) % 3] = 1.0, v[size_t(a + 2) % 3] = 1.0;
         const double middle = 0.5 * (prism->loMm + prism->hiMm);
+        if (const auto [lo, hi] = extentAlong(field, slots[p], a);
+            hi - lo <= maxMouthRingMm &&
+            (lo <= prism->loMm + 2.0 * field.voxelMm || hi >= prism->hiMm - 2.0 * field.voxelMm)) {
+            sets[p].isMouthRing = true;
+            sets[p].ringDepthMm = hi - lo;
+            continue;
+        }
         std::vector<uint32_t> halves{p};
         if (const auto [lo, hi] = extentAlong(field, slots[p], a); lo < middle && hi > middle)
             halves.push_back(split(p, axis, middle));
@@ -77,10 +85,12 @@ size_t noteUnheldStaves(Pieces& out, const std::vector<CellSet>& sets) {
     return unheld;
 }
 
-bool isStaveSet(const CellSet& set) {
+bool isStavedLining(const CellSet& set) {
     const TunnelPrism* prism = set.isLining ? ownPrism(set) : nullptr;
     return prism && prism->isStaved;
 }
+
+bool isStaveSet(const CellSet& set) { return !set.isMouthRing && isStavedLining(set); }
 
 bool isStaveDirection(const Stave& stave, const Vec3d& d) {
     // 2°: over a lift of 8 mm, a quarter of a millimetre; over 40 mm (a stem to a ball deep in),

@@ -111,6 +111,9 @@ public:
         /// as kPieces, for a piece cut into parts glued before mounting (splitForPrint): judged by
         /// the steps under-held (kGroups), which must not grow
         kParts,
+        /// the frame grown toward staves: judged by the staves the plan places nowhere, which must
+        /// be fewer (the plan need not be one that can be carried out: more rounds may follow)
+        kStaves,
     };
     /// Makes @p change, recomputes what it touched (for kPieces the faces and the tenon candidates,
     /// for kFrame the sweeps and the candidates) and plans again. Returns the new count of under-held pieces
@@ -157,8 +160,9 @@ private:
 /// Where the plan places staves nowhere (no hole behind a stave's wall holds it): struts to new
 /// balls whose holes along a direction the stave may take (isStaveDirection, the nearest its lift
 /// first) are its tenon candidates, up to --min-tenons per stave, found as growFrameForPieces
-/// finds them; kept when the plan made again can be carried out. Not where more than a few tunnels'
-/// staves are unheld (kMaxStavesToGrow). Returns how many struts were kept.
+/// finds them; kept when the plan made again places fewer staves nowhere, in rounds while it does
+/// (a ball grown for one stave may be in another's way, or take the spot it needed). Returns how
+/// many struts were kept.
 size_t growFrameForStaves(Replanner& r, const StrutTest& canGrow);
 
 /// Grows the frame toward the pieces fewer than minPerPiece pegs hold along their planned direction

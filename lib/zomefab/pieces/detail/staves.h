@@ -55,7 +55,11 @@ size_t noteUnheldStaves(Pieces& out, const std::vector<CellSet>& sets);
 /// How many staves (@p sets) a plan places nowhere (@p holeOfPiece −1).
 size_t unheldStaves(const std::vector<int>& holeOfPiece, const std::vector<CellSet>& sets);
 
-/// Whether @p set's piece lines a staved prism: a stave, which no re-cut may cut across its seams.
+/// Whether @p set's piece lines a staved prism: a stave or a mouth ring (CellSet::isMouthRing).
+bool isStavedLining(const CellSet& set);
+
+/// Whether @p set's piece is a stave (a staved prism's lining but not a mouth ring), which no
+/// re-cut may cut across its seams.
 bool isStaveSet(const CellSet& set);
 
 /// The stave @p set's piece is (its voxels' centres @p voxelsMm, grid mm), or none for a piece that
@@ -66,9 +70,12 @@ std::optional<Stave> staveOf(const CellSet& set, const std::vector<Vec3d>& voxel
 /// mouth), each half into equal rings no longer than kStaveRingMm, each ring into four staves:
 /// across u at ±√½ of the core's radius (the side staves, whose seams are across their lift), then
 /// across v at the middle (top and bottom, sliding along the side staves' seams as they are lifted).
-/// Sets each ring's depth (CellSet::ringDepthMm). Returns how many cuts; pieces the cuts left empty
-/// are the caller's to drop.
-size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field);
+/// A lining that reaches its mouth and is no longer than @p maxMouthRingMm (between the mouth and
+/// the first crossing: behind it lies only the face's wall, no ball) stays one ring, a mouth ring
+/// (CellSet::isMouthRing). Sets each ring's depth (CellSet::ringDepthMm). Returns how many cuts;
+/// pieces the cuts left empty are the caller's to drop.
+size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field,
+                 double maxMouthRingMm);
 
 /// How far a stave is held off its place while it slides (mm) before its tenons are known: its
 /// pegs' depth (4 mm) and as much again (setStaveLifts makes it longer).

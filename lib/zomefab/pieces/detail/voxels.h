@@ -75,6 +75,9 @@ struct CellSet {
     /// A stave's ring (a staved prism's lining): how far its far end lies from the mouth it slides
     /// out of (mm), which orders the rings along the tunnel (detail/prisms.h, Stave).
     double ringDepthMm = 0.0;
+    /// A staved prism's lining at a mouth too short to reach behind the face's wall (cutStaves):
+    /// one ring, not cut into staves, that slides in along the tunnel and is glued on.
+    bool isMouthRing = false;
 };
 
 /// δ_P: a signed distance to the region of the piece's cells (negative inside), from the planes
