@@ -61,13 +61,14 @@ TEST_CASE(
 /// The cube with three tunnels crossing, the lining the z prism keeps (it keeps every overlap) as
 /// piece 0 and the rest of the shell as piece 1.
 struct ZLining {
-    VoxelField three = cubeWithTunnels(64, 10.0, {0, 1, 2}, 4.0);
+    VoxelField three;
     std::vector<TunnelPrism> prisms;
     std::vector<zomefab::pieces::Piece> pieces = std::vector<zomefab::pieces::Piece>(2);
     std::vector<CellSet> sets = std::vector<CellSet>(2);
     size_t lining = 0;  ///< its inside voxels
 
-    ZLining() {
+    explicit ZLining(double hollowWallMm = 0.0)
+        : three(cubeWithTunnels(64, 10.0, {0, 1, 2}, 4.0, hollowWallMm)) {
         bool isTriple = false;
         prisms = crossingPrisms(three, 8.0, 6.0, 5.0, &isTriple, true);
         REQUIRE(prisms.size() == 3);
@@ -130,4 +131,43 @@ TEST_CASE("cutStaves: a lining at a mouth no longer than a mouth ring stays one 
     CHECK_FALSE(isStaveSet(sets[0]));
     CHECK_FALSE(staveOf(sets[0], {Vec3d{31.5, 31.5, 31.5}}).has_value());
     CHECK_FALSE(isStavedLining(sets[1]));
+}
+
+TEST_CASE("staveUnderThinWall: a stave whose face lies a little hollow away") {
+    // A hollow cube with walls of 4 mm: between the z tunnel's lining (radius 10 to 14 mm round the
+    // middle, 31.5 mm) and the faces' walls (from 60 mm) lies a hollow about 14 mm across.
+    ZLining z(4.0);
+    REQUIRE(cutStaves(z.pieces, z.sets, z.three, 20.0) == 7);
+    std::vector<std::vector<Vec3d>> voxels(z.pieces.size());
+    for (size_t s = 0; s < z.three.owner.size(); ++s)
+        if (z.three.isInside(s)) voxels[z.three.owner[s]].push_back(z.three.world(z.three.coordOf(s)));
+    size_t near = 0, far = 0, staves = 0;
+    for (uint32_t p = 0; p < z.pieces.size(); ++p) {
+        const std::optional<Stave> st = staveOf(z.sets[p], voxels[p]);
+        if (!st) continue;
+        ++staves;
+        near += staveUnderThinWall(*st, p, voxels[p], z.three, 24.0) ? 1 : 0;
+        far += staveUnderThinWall(*st, p, voxels[p], z.three, 4.0) ? 1 : 0;
+    }
+    CHECK(staves == 8);
+    CHECK(near == 8);
+    CHECK(far == 0);
+    CHECK(ballGapMm(8.75, 19.0, 16.0) == doctest::Approx(23.5));
+    // A plan that places every stave nowhere: its first problem says how many, and how many are thin.
+    zomefab::pieces::Pieces out;
+    out.pieces = z.pieces;
+    out.plan.holeOfPiece.assign(out.pieces.size(), -1);
+    CHECK(noteUnheldStaves(out, z.sets, z.three, 24.0) == 8);
+    REQUIRE_FALSE(out.plan.problems.empty());
+    const std::string& first = out.plan.problems[0];
+    CHECK(first.find("8 of the 8 staves lining them have no peg") != std::string::npos);
+    CHECK(first.find(
+              "8 of them under a wall too thin for a ball behind them (another wall less than 24.0 mm") !=
+          std::string::npos);
+    CHECK(out.crossingTunnelPieces == 8);
+    zomefab::pieces::Pieces thick;
+    thick.pieces = z.pieces;
+    thick.plan.holeOfPiece.assign(thick.pieces.size(), -1);
+    CHECK(noteUnheldStaves(thick, z.sets, z.three, 4.0) == 8);
+    CHECK(thick.plan.problems[0].find("too thin") == std::string::npos);
 }

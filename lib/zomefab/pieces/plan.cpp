@@ -518,7 +518,9 @@ void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping
     // What follows is for pieces that will be made; a plan with problems is refused (requireBuildable),
     // unless there are no tenons to plan (--max-tenons 0: pieces without a plan, numbered all the same).
     if (opt.tenons.maxPerPiece > 0 && !out.plan.isBuildable()) {
-        if (noteUnheldStaves(out, grouping.cellSets) == 0)
+        if (noteUnheldStaves(
+                out, grouping.cellSets, field,
+                ballGapMm(frame.scale().ballRadiusMm(), fabrication.frameDMinMm(), fabrication.wallMm)) == 0)
             noteCrossingTunnels(out, field, fabrication.wallMm);
         return;
     }

@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 
+#include "zomefab/core/format.h"
 #include "zomefab/pieces/detail/mounting.h"
 #include "zomefab/pieces/detail/splits.h"
 
@@ -69,18 +70,53 @@ size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelFi
     return cuts;
 }
 
-size_t noteUnheldStaves(Pieces& out, const std::vector<CellSet>& sets) {
+bool staveUnderThinWall(const Stave& stave, uint32_t p, const std::vector<Vec3d>& voxelsMm,
+                        const VoxelField& field, double thinGapMm) {
+    size_t samples = 0, thin = 0;
+    for (const Vec3d& x : voxelsMm) {
+        // Its wall's back, where the hollow begins (not a rim in the face's shell, beside other pieces).
+        const size_t next = field.slotAt(madd(x, field.voxelMm, stave.liftGrid));
+        if (next != SIZE_MAX && field.isInside(next)) continue;
+        ++samples;
+        // Across the hollow, voxel by voxel, to another piece's material.
+        for (double t = 2.0 * field.voxelMm; t <= thinGapMm + 2.0 * field.voxelMm; t += field.voxelMm) {
+            const size_t s = field.slotAt(madd(x, t, stave.liftGrid));
+            if (s == SIZE_MAX || !field.isInside(s) || field.owner[s] == p) continue;
+            thin += t - field.voxelMm <= thinGapMm ? 1 : 0;
+            break;
+        }
+    }
+    return samples > 0 && 2 * thin > samples;
+}
+
+size_t noteUnheldStaves(Pieces& out, const std::vector<CellSet>& sets, const VoxelField& field,
+                        double thinGapMm) {
     const size_t unheld = unheldStaves(out.plan.holeOfPiece, sets);
     if (unheld == 0) return 0;
     const size_t staves = size_t(std::count_if(sets.begin(), sets.end(), isStaveSet));
+    std::vector<std::vector<Vec3d>> voxels(out.pieces.size());
+    for (size_t s = 0; s < field.phi.size(); ++s) {
+        const uint32_t p = field.owner[s];
+        if (field.isInside(s) && p < out.pieces.size() && out.plan.holeOfPiece[p] < 0 && isStaveSet(sets[p]))
+            voxels[p].push_back(field.world(field.coordOf(s)));
+    }
+    size_t thin = 0;
+    for (uint32_t p = 0; p < out.pieces.size(); ++p)
+        if (const std::optional<Stave> st = staveOf(sets[p], voxels[p]))
+            thin += staveUnderThinWall(*st, p, voxels[p], field, thinGapMm) ? 1 : 0;
+    std::string under;
+    if (thin > 0)
+        under = ", " + std::to_string(thin) +
+                " of them under a wall too thin for a ball behind them (another " + "wall less than " +
+                formatNumbers("%.1f", thinGapMm) + " mm of hollow away)";
     out.plan.problems.insert(
         out.plan.problems.begin(),
         "three tunnels cross at one point, and " + std::to_string(unheld) + " of the " +
-            std::to_string(staves) +
-            " staves lining them have no peg to hold them: no ball's hole behind the wall points at the "
-            "stave within a tenon's reach along a direction it can be lifted along (square to its seams, "
-            "not back toward the staves deeper in), or another stave's tenon took it; partitioning again "
-            "leaves the same tunnels and frame (docs/mounting.md, \"Three tunnels through one point\")");
+            std::to_string(staves) + " staves lining them have no peg to hold them" + under +
+            ": no ball's hole behind the wall points at the stave within a tenon's reach along a direction "
+            "it can be lifted along (square to its seams, not back toward the staves deeper in), or another "
+            "stave's tenon took it; partitioning again leaves the same tunnels and frame (docs/mounting.md, "
+            "\"Three tunnels through one point\")");
     out.crossingTunnelPieces = unheld;
     return unheld;
 }

@@ -48,9 +48,24 @@ inline constexpr double kStaveRingMm = 160.0;
 bool isStaveDirection(const Stave& stave, const Vec3d& d);
 
 /// After a plan that cannot be carried out: when staves (@p sets) are placed nowhere, the plan's
-/// first problem says how many and why, and Pieces::crossingTunnelPieces is set (another partition
-/// leaves the same tunnels and the same frame behind them). Returns how many.
-size_t noteUnheldStaves(Pieces& out, const std::vector<CellSet>& sets);
+/// first problem says how many and why, how many of them lie under a wall too thin for a ball
+/// (staveUnderThinWall, with @p thinGapMm), and Pieces::crossingTunnelPieces is set (another
+/// partition leaves the same tunnels and the same frame behind them). Returns how many.
+size_t noteUnheldStaves(Pieces& out, const std::vector<CellSet>& sets, const VoxelField& field,
+                        double thinGapMm);
+
+/// The hollow a ball needs between two walls (mm): its diameter and, on each side, the air the
+/// frame keeps beyond the wall (@p frameDMinMm − @p wallMm).
+inline double ballGapMm(double ballRadiusMm, double frameDMinMm, double wallMm) {
+    return 2.0 * (ballRadiusMm + frameDMinMm - wallMm);
+}
+
+/// Whether the stave (@p voxelsMm, grid mm; its own piece @p p) lies under a wall too thin for a
+/// ball behind it: from most of the voxels at its wall's back along its lift (hollow beyond them),
+/// another piece's wall begins within @p thinGapMm of hollow (the cheese at 700 mm: a face 13.5 mm
+/// away). Such a stave no peg can hold, however the frame grows.
+bool staveUnderThinWall(const Stave& stave, uint32_t p, const std::vector<Vec3d>& voxelsMm,
+                        const VoxelField& field, double thinGapMm);
 
 /// How many staves (@p sets) a plan places nowhere (@p holeOfPiece −1).
 size_t unheldStaves(const std::vector<int>& holeOfPiece, const std::vector<CellSet>& sets);
