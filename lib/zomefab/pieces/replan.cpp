@@ -35,12 +35,13 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
     const Stopwatch clock;
     State kept{out.pieces, grouping.cellSets, grouping.faces, field.owner, out.plan, candidates,
                lost,       preGlued,          std::nullopt};
-    if (kind == Change::kFrame) kept.frame = frame;
+    const bool isFrame = kind == Change::kFrame || kind == Change::kStaves;
+    if (isFrame) kept.frame = frame;
     change();
     const bool steps = kind == Change::kGroups || kind == Change::kParts;
     if (kind == Change::kPieces || kind == Change::kMorePieces || kind == Change::kParts)
         grouping.faces = faceContacts(field, cells, grouping.cellSets, out.pieces);
-    else if (kind == Change::kFrame)
+    else if (isFrame)
         remakeSweeps();
     if (kind !=
         Change::kGroups)  // glued groups leave the pieces and the frame, so the candidates, as they are

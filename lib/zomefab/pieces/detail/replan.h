@@ -111,8 +111,9 @@ public:
         /// as kPieces, for a piece cut into parts glued before mounting (splitForPrint): judged by
         /// the steps under-held (kGroups), which must not grow
         kParts,
-        /// the frame grown toward staves: judged by the staves the plan places nowhere, which must
-        /// be fewer (the plan need not be one that can be carried out: more rounds may follow)
+        /// as kFrame, for the frame grown toward staves: judged by the staves the plan places
+        /// nowhere, which must be fewer (the plan need not be one that can be carried out: more
+        /// rounds may follow)
         kStaves,
     };
     /// Makes @p change, recomputes what it touched (for kPieces the faces and the tenon candidates,
