@@ -43,10 +43,8 @@ cube "$out.two.stl" "0, 1"
 cube "$out.three.stl" "0, 1, 2"
 
 # 1.5 mm voxels: the same outcome in 3 minutes instead of 5.5 (most of it the rounds of gluing to be held).
-"$zf" run "$out.two.stl" --up z --height-mm 300 --voxel-mm 1.5 -o "$out" -v 2>"$out.err"
-rc=$?
-grep -E "tunnels cross|partitioning again for|verif" "$out.err" | cut -c1-300
-[ $rc -eq 0 ] || { echo "two tunnels: zomefab run exited $rc, expected 0"; tail -3 "$out.err" | cut -c1-600; exit 1; }
+run_made "$zf" "$out.two.stl" 300 "$out" "tunnels cross|partitioning again for" --voxel-mm 1.5 ||
+    { echo "two tunnels: expected exit 0"; exit 1; }
 grep -q "mounting: 2 tunnels cross; their linings carved into [0-9]* pieces along them" "$out.err" ||
     { echo "two tunnels: the linings were not carved"; exit 1; }
 python3 - "$out" <<'PY' || exit 1
@@ -59,10 +57,8 @@ steps = inst["steps"]
 print(f"two tunnels: {report['verify']['bodies']} mounting steps, {len(inst['glued_on'])} pieces glued on, verified")
 PY
 
-"$zf" run "$out.three.stl" --up z --height-mm 300 --voxel-mm 2 -o "$out.three" -v 2>"$out.three.err"
-rc=$?
-grep -E "three at a time|partitioning again for|verif" "$out.three.err" | cut -c1-300
-[ $rc -eq 0 ] || { echo "three tunnels: zomefab run exited $rc, expected 0"; tail -3 "$out.three.err" | cut -c1-600; exit 1; }
+run_made "$zf" "$out.three.stl" 300 "$out.three" "three at a time|partitioning again for" --voxel-mm 2 ||
+    { echo "three tunnels: expected exit 0"; exit 1; }
 grep -q "mounting: 3 tunnels cross three at a time; their linings carved into [0-9]* pieces along them and cut into [0-9]* staves" "$out.three.err" ||
     { echo "three tunnels: the linings were not cut into staves"; exit 1; }
 python3 - "$out.three" <<'PY' || exit 1

@@ -17,10 +17,11 @@ PY
     } | python3 - "$1"
 }
 
-# run_made ZOMEFAB MESH HEIGHT_MM OUTDIR PATTERN: `zomefab run MESH --up z` into OUTDIR, prints its
-# stderr lines matching PATTERN and the verifier's; fails (1) unless zomefab exits 0.
+# run_made ZOMEFAB MESH HEIGHT_MM OUTDIR PATTERN [OPTION...]: `zomefab run MESH --up z [OPTION...]`
+# into OUTDIR, prints its stderr lines matching PATTERN and the verifier's; fails (1) unless zomefab
+# exits 0.
 run_made() {
-    "$1" run "$2" --up z --height-mm "$3" -o "$4" -v 2>"$4.err"
+    "$1" run "$2" --up z --height-mm "$3" -o "$4" -v "${@:6}" 2>"$4.err"
     local rc=$?
     grep -E "$5|verify:" "$4.err" | cut -c1-300
     [ $rc -eq 0 ] || { echo "zomefab run exited $rc"; tail -3 "$4.err"; return 1; }

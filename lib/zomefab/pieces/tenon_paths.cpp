@@ -2,6 +2,7 @@
 // Tenons in later pieces' paths (detail/replan.h, docs/mounting.md, "Tenons lost to other pieces"):
 // a stem of a piece already on that a later step's body would sweep, straight or along a stave's
 // two legs, is marked lost and the plan made again without it.
+#include <optional>
 #include <set>
 
 #include "zomefab/mount/sweep.h"
@@ -46,11 +47,16 @@ size_t markTenonsInPaths(const mount::InstallationPlan& plan, const TenonPlan& t
         both.expand(stem.min), both.expand(stem.max);
         const mount::SweepAxes axes(d);
         mount::DepthRaster obstacle(axes, both, voxelMm, true, voxelMm),
-            body(axes, both, voxelMm, false, voxelMm), far(axes, both, voxelMm, true, voxelMm);
+            body(axes, both, voxelMm, false, voxelMm);
+        // A leg of limited reach (a lift): the stem clipped past the body's far side.
+        std::optional<mount::DepthRaster> far;
+        if (reachMm > 0) far.emplace(axes, both, voxelMm, true, voxelMm);
         for (uint32_t p : step.pieces)
-            for (const Vec3d& x : input.pieces[p].voxels)
-                body.addPoint(add(x, fromMm), 0.0, p), far.addPoint(add(x, fromMm), 0.0, p);
-        if (reachMm > 0) obstacle.limitReach(far, reachMm);
+            for (const Vec3d& x : input.pieces[p].voxels) {
+                body.addPoint(add(x, fromMm), 0.0, p);
+                if (far) far->addPoint(add(x, fromMm), 0.0, p);
+            }
+        if (far) obstacle.limitReach(*far, reachMm);
         drawStem(obstacle, t, o, 0.5 * voxelMm, 0);
         return mount::worstHit(obstacle, body, voxelMm).isHit;
     };

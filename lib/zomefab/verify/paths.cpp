@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <mutex>
+#include <optional>
 
 #include "zomefab/core/format.h"
 #include "zomefab/core/vec.h"
@@ -82,13 +83,16 @@ LegHits sweepLeg(const Assembly& a, const std::vector<PieceGeometry>& geometry, 
     all.expand(bounds.min), all.expand(bounds.max);
     // One lattice for the whole object; each test on the window of the moving body.
     const mount::DepthRaster lattice(axes, all, o.pixelMm, true);
-    mount::DepthRaster body(lattice, bounds, false, 1.0), far(lattice, bounds, true, 1.0);
+    mount::DepthRaster body(lattice, bounds, false, 1.0);
     drawPieces(body, geometry, steps[s].pieces, 0.0, fromMm);
-    mount::DepthRaster frame(lattice, bounds, true, 1.0);
+    // A leg of limited reach: the obstacles clipped past the body's far side (a lift, not a push).
+    std::optional<mount::DepthRaster> far;
     if (reachMm > 0) {
-        drawPieces(far, geometry, steps[s].pieces, 0.0, fromMm);
-        frame.limitReach(far, reachMm);
+        far.emplace(lattice, bounds, true, 1.0);
+        drawPieces(*far, geometry, steps[s].pieces, 0.0, fromMm);
     }
+    mount::DepthRaster frame(lattice, bounds, true, 1.0);
+    if (far) frame.limitReach(*far, reachMm);
     drawFrame(frame, a, hole, o);
     LegHits hits;
     hits.frame = mount::worstHit(frame, body, o.materialToleranceMm);
@@ -96,7 +100,7 @@ LegHits sweepLeg(const Assembly& a, const std::vector<PieceGeometry>& geometry, 
     // slides along at a grazing angle is seen edge-on, where the two meshes' few hundredths of
     // a millimetre apart would read as centimetres along the direction.
     mount::DepthRaster before(lattice, bounds, true, 1.0), shrunk(lattice, bounds, false, 1.0);
-    if (reachMm > 0) before.limitReach(far, reachMm);
+    if (far) before.limitReach(*far, reachMm);
     for (size_t e = 0; e < s; ++e) drawPieces(before, geometry, steps[e].pieces, -o.orderShrinkMm);
     drawPieces(shrunk, geometry, steps[s].pieces, -o.orderShrinkMm, fromMm);
     hits.pieces = mount::worstHit(before, shrunk, o.orderToleranceMm);

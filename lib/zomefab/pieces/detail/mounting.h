@@ -121,7 +121,7 @@ struct PlannerInput {
     /// Where no order exists, glue stuck bodies in each other's way into one and plan again (a few
     /// rounds). Off: such a plan is returned stuck at once (a trial that only wants a better plan).
     bool isGluingStuck = true;
-    /// Per piece, the stave it is (detail/prisms.h): staves go on first, in their order, along two
+    /// Per piece, the stave it is (detail/staves.h): staves go on first, in their order, along two
     /// legs; never glued. Empty: no piece is one.
     std::vector<std::optional<Stave>> staves;
 };

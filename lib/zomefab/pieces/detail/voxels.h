@@ -73,7 +73,7 @@ struct CellSet {
     /// A lining carved along a prism: its cells do not bound it, only its prisms and half-spaces.
     bool isLining = false;
     /// A stave's ring (a staved prism's lining): how far its far end lies from the mouth it slides
-    /// out of (mm), which orders the rings along the tunnel (detail/prisms.h, Stave).
+    /// out of (mm), which orders the rings along the tunnel (detail/staves.h, Stave).
     double ringDepthMm = 0.0;
     /// A staved prism's lining at a mouth too short to reach behind the face's wall (cutStaves):
     /// one ring, not cut into staves, that slides in along the tunnel and is glued on.
