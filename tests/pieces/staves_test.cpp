@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "tunnel_fixtures.h"
+#include "zomefab/pieces/detail/mounting.h"
+#include "zomefab/zome/zome_system.h"
 
 using namespace zomefab;
 using namespace zomefab::pieces::detail;
@@ -90,7 +92,7 @@ TEST_CASE("cutStaves: a staved lining is cut at its tunnel's middle and each rin
     const size_t lining = z.lining;
     REQUIRE(lining > 1000);
     // Two halves of 32 mm, one ring each (under kStaveRingMm), four staves per ring: seven cuts.
-    CHECK(cutStaves(pieces, sets, three, 20.0) == 7);  // 64 mm: longer than a mouth ring
+    CHECK(cutStaves(pieces, sets, three, 6.0, 0.0) == 7);  // 64 mm: longer than a mouth ring (18 mm)
     REQUIRE(pieces.size() == 9);
     const double c = prisms[2].centerUMm, off = std::sqrt(0.5) * prisms[2].coreRadiusMm;
     std::vector<std::vector<Vec3d>> voxels(pieces.size());
@@ -122,8 +124,8 @@ TEST_CASE("cutStaves: a staved lining is cut at its tunnel's middle and each rin
 TEST_CASE("cutStaves: a lining at a mouth no longer than a mouth ring stays one ring") {
     ZLining z;
     std::vector<CellSet>& sets = z.sets;
-    // The z lining runs from mouth to mouth, 63 mm between its voxels' centres: under 70 mm.
-    CHECK(cutStaves(z.pieces, sets, z.three, 70.0) == 0);
+    // The z lining runs from mouth to mouth, 63 mm between its voxels' centres: under three walls of 24 mm.
+    CHECK(cutStaves(z.pieces, sets, z.three, 24.0, 0.0) == 0);
     REQUIRE(z.pieces.size() == 2);
     CHECK(sets[0].isMouthRing);
     CHECK(sets[0].ringDepthMm == doctest::Approx(63.0).epsilon(0.05));
@@ -137,7 +139,7 @@ TEST_CASE("staveUnderThinWall: a stave whose face lies a little hollow away") {
     // A hollow cube with walls of 4 mm: between the z tunnel's lining (radius 10 to 14 mm round the
     // middle, 31.5 mm) and the faces' walls (from 60 mm) lies a hollow about 14 mm across.
     ZLining z(4.0);
-    REQUIRE(cutStaves(z.pieces, z.sets, z.three, 20.0) == 7);
+    REQUIRE(cutStaves(z.pieces, z.sets, z.three, 6.0, 0.0) == 7);  // no gap: cut square to the grid
     std::vector<std::vector<Vec3d>> voxels(z.pieces.size());
     for (size_t s = 0; s < z.three.owner.size(); ++s)
         if (z.three.isInside(s)) voxels[z.three.owner[s]].push_back(z.three.world(z.three.coordOf(s)));
@@ -170,4 +172,130 @@ TEST_CASE("staveUnderThinWall: a stave whose face lies a little hollow away") {
     thick.plan.holeOfPiece.assign(thick.pieces.size(), -1);
     CHECK(noteUnheldStaves(thick, z.sets, z.three, 4.0) == 8);
     CHECK(thick.plan.problems[0].find("too thin") == std::string::npos);
+}
+
+TEST_CASE("cutStaves: a lining under a face's thin wall is cut into staves turned 45° about its axis") {
+    // The hollow cube of 4 mm walls: square to the grid each stave faces a face's wall 14 to 18 mm of
+    // hollow away, along a diagonal 19 to 24 mm; a ball needing 18 mm fits only there.
+    ZLining z(4.0);
+    REQUIRE(cutStaves(z.pieces, z.sets, z.three, 6.0, 18.0) == 7);
+    std::vector<std::vector<Vec3d>> voxels(z.pieces.size());
+    for (size_t s = 0; s < z.three.owner.size(); ++s)
+        if (z.three.isInside(s)) voxels[z.three.owner[s]].push_back(z.three.world(z.three.coordOf(s)));
+    const Vec3d c{z.prisms[2].centerUMm, z.prisms[2].centerVMm, 0.0};
+    const double off = std::sqrt(0.5) * z.prisms[2].coreRadiusMm;
+    size_t staves = 0, thin = 0, sides = 0;
+    for (uint32_t p = 0; p < z.pieces.size(); ++p) {
+        const std::optional<Stave> st = staveOf(z.sets[p], voxels[p]);
+        if (!st) continue;
+        ++staves;
+        CHECK(z.sets[p].isStaveTurned);
+        // Lifted along a diagonal of x and y, across the z axis.
+        CHECK(std::abs(st->liftGrid[0]) == doctest::Approx(std::sqrt(0.5)));
+        CHECK(std::abs(st->liftGrid[1]) == doctest::Approx(std::sqrt(0.5)));
+        CHECK(st->liftGrid[2] == 0.0);
+        // A side stave lies beyond its seam, across its lift; top and bottom between the seams.
+        for (const Vec3d& x : voxels[p]) {
+            const Vec3d r{x[0] - c[0], x[1] - c[1], 0.0};
+            if (st->isSide)
+                CHECK(dot(r, st->liftGrid) >= off - 1e-9);
+            else
+                CHECK(std::abs(dot(r, st->seamGrid)) <= off + 1e-9);
+        }
+        sides += st->isSide ? 1 : 0;
+        thin += staveUnderThinWall(*st, p, voxels[p], z.three, 18.0) ? 1 : 0;
+    }
+    CHECK(staves == 8);
+    CHECK(sides == 4);
+    CHECK(thin == 0);  // square to the grid all 8 would (14 to 18 mm)
+    // The lean a turned stave needs: a yellow hole (±1, ±1, ±1) beside its diagonal.
+    CHECK(std::acos(std::sqrt(2.0 / 3.0)) * 180.0 / kPi < kStaveLeanDeg);
+}
+
+TEST_CASE(
+    "markCrossings and splitMm: where three tunnels cross, a lining is split at the crossing nearest "
+    "its middle") {
+    ZLining z;
+    std::vector<TunnelPrism> prisms = z.prisms;
+    markCrossings(prisms);
+    for (const TunnelPrism& p : prisms) {
+        REQUIRE(p.crossingsMm.size() == 1);  // the other two cross at one point
+        CHECK(p.crossingsMm[0].first == doctest::Approx(31.5).epsilon(0.02));
+        CHECK(p.splitMm() == doctest::Approx(31.5).epsilon(0.02));
+    }
+    // The cheese at 700 mm: a tunnel along z crossed at 87.5, 262.5, 437.5 and 612.5 mm.
+    TunnelPrism t;
+    t.axis = 2, t.loMm = 0.0, t.hiMm = 700.0;
+    CHECK(t.splitMm() == 350.0);
+    t.crossingsMm = {{87.5, 42.0}, {262.5, 42.0}, {437.5, 42.0}, {612.5, 42.0}};
+    CHECK(t.splitMm() == 262.5);  // a tie: the lower
+}
+
+TEST_CASE("isMouthRingExtent: a lining between a face and the first crossing with no room for a ball") {
+    TunnelPrism t;
+    t.axis = 2, t.loMm = 0.0, t.hiMm = 700.0, t.voxelMm = 1.0;
+    t.crossingsMm = {{87.5, 42.0}, {262.5, 42.0}, {437.5, 42.0}, {612.5, 42.0}};
+    // 87.5 mm from the face to the crossing's axis, 42 mm to its wall, two walls of 16 mm: 13.5 mm of
+    // hollow, less than a ball's 23.7.
+    CHECK(isMouthRingExtent(t, 0.0, 77.0, 1.0, 16.0, 23.7));
+    CHECK(isMouthRingExtent(t, 623.0, 700.0, 1.0, 16.0, 23.7));
+    CHECK_FALSE(isMouthRingExtent(t, 0.0, 77.0, 1.0, 16.0, 10.0));    // a ball fits: 77 mm is 4.8 walls
+    CHECK_FALSE(isMouthRingExtent(t, 98.0, 252.0, 1.0, 16.0, 23.7));  // at no mouth
+    CHECK_FALSE(isMouthRingExtent(t, 0.0, 100.0, 1.0, 16.0, 23.7));   // past the crossing
+    CHECK(isMouthRingExtent(t, 0.0, 40.0, 1.0, 16.0, 10.0));          // within three walls
+    // The three-tunnel cube: 150 mm from a face to a crossing 90 mm across, room for a ball.
+    TunnelPrism cube;
+    cube.axis = 0, cube.loMm = 0.0, cube.hiMm = 300.0;
+    cube.crossingsMm = {{150.0, 45.0}};
+    CHECK_FALSE(isMouthRingExtent(cube, 0.0, 87.0, 1.0, 16.0, 23.7));
+}
+
+TEST_CASE(
+    "glueStavesInPlace: a stave no hole holds slides to its place after its ring and is glued onto it") {
+    // Two rings of a tunnel along x sliding out toward +x: pieces 0-3 the deeper ring (0, 1 sides;
+    // 2, 3 top and bottom), 4-7 the shallower. Holes hold all but 2 and 3 (2 shares seams with both
+    // held sides, 3 only with 2: a chain) and 6 (no seam large enough with a stave on before it).
+    PlannerInput input;
+    input.pieces.resize(8);
+    input.staves.resize(8);
+    for (uint32_t p = 0; p < 8; ++p) {
+        Stave st;
+        st.slideGrid = {1, 0, 0};
+        st.isSide = p % 4 < 2;
+        st.rank = {0, 10.0, 20.0, 1.0, p < 4 ? -160.0 : -80.0, st.isSide ? 0 : 1, p % 2 ? -1.0 : 1.0};
+        input.staves[p] = st;
+    }
+    FaceContacts faces;
+    auto seam = [&](uint32_t a, uint32_t b, size_t voxelFaces) {
+        faces[{std::min(a, b), std::max(a, b)}].push_back({{0, 1, 0}, voxelFaces, true});
+    };
+    seam(0, 2, 900), seam(1, 2, 900), seam(2, 3, 900);
+    seam(4, 6, 100), seam(5, 6, 100);  // under 150 mm²
+    StaveOrder order{{0, 1, 2, 3, 4, 5, 6, 7}, {7, 7, -1, -1, 7, 7, -1, 7}, {}};
+    const Transform4d identity = Transform4d::identity();
+    const std::vector<size_t> perm = glueStavesInPlace(order, input, faces, identity, 1.0);
+    // The deeper ring first: its held staves, then 2, then 3 on it; 6 stays unheld after 4, 5, 7.
+    CHECK(perm == std::vector<size_t>{0, 1, 2, 3, 4, 5, 7, 6});
+    CHECK(order.pieces == std::vector<uint32_t>{0, 1, 2, 3, 4, 5, 7, 6});
+    REQUIRE(order.hosts.size() == 8);
+    CHECK(order.hosts[2] == std::vector<uint32_t>{0, 1});
+    CHECK(order.hosts[3] == std::vector<uint32_t>{2});
+    CHECK(order.holes[2] >= 0);
+    // Its hole lies along its slide (it is taken off out of its mouth, straight).
+    CHECK(dot(gridDirection(order.holes[2], identity), Vec3d{1, 0, 0}) == doctest::Approx(1.0));
+    CHECK(order.holes[7] == -1);
+    CHECK(order.hosts[7].empty());
+    // Its step: one leg along that hole, glued onto both sides.
+    mount::InstallationPlan plan;
+    plan.holeOfPiece.assign(8, -1);
+    order.holes[7] = 7;  // (as if a hole held it: a plan with no problem)
+    addStaveSteps(plan, input, order, identity);
+    REQUIRE(plan.steps.size() == 8);
+    CHECK(plan.steps[2].pieces == std::vector<uint32_t>{2});
+    CHECK_FALSE(plan.steps[2].hasTwoLegs());
+    CHECK(plan.steps[0].hasTwoLegs());
+    CHECK(plan.gluedOn == std::vector<std::pair<uint32_t, uint32_t>>{{0, 2}, {1, 2}, {2, 3}});
+    plan.holeOfPiece[2] = order.holes[2];
+    CHECK(isGluedOn(plan, 2));
+    CHECK_FALSE(isGluedOn(plan, 0));
 }

@@ -146,7 +146,7 @@ size_t growTowardStaves(const Replanner& r, const StrutTest& canGrow, zome::Stru
     const size_t minPegs = size_t(std::max(1, r.opt.tenons.minPerPiece));
     size_t added = 0;
     for (uint32_t p = 0; p < r.out.pieces.size(); ++p) {
-        if (r.out.plan.holeOfPiece[p] >= 0 || boxes[p].isEmpty()) continue;
+        if ((r.out.plan.holeOfPiece[p] >= 0 && !isGluedOn(r.out.plan, p)) || boxes[p].isEmpty()) continue;
         const std::optional<Stave> st = staveOf(r.grouping.cellSets[p], input.pieces[p].voxels);
         if (!st) continue;
         std::vector<std::pair<double, int>> holes;
@@ -168,9 +168,9 @@ size_t growTowardStaves(const Replanner& r, const StrutTest& canGrow, zome::Stru
 
 size_t growFrameForStaves(Replanner& r, const StrutTest& canGrow) {
     size_t grown = 0;
-    for (int round = 0; round < kStaveGrowRounds && canGrow && !r.out.plan.isBuildable(); ++round) {
+    for (int round = 0; round < kStaveGrowRounds && canGrow; ++round) {
         r.context.throwIfCancelled();
-        const size_t before = unheldStaves(r.out.plan.holeOfPiece, r.grouping.cellSets);
+        const size_t before = peglessStaves(r.out.plan, r.grouping.cellSets);
         if (before == 0) break;
         zome::Structure trial = r.frame;
         const size_t added = growTowardStaves(r, canGrow, trial);

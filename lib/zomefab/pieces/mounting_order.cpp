@@ -527,15 +527,19 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
     std::sort(staves.begin(), staves.end(), [&](uint32_t a, uint32_t b) {
         return std::tie(input.staves[a]->rank, a) < std::tie(input.staves[b]->rank, b);
     });
-    std::vector<int> staveHoles(staves.size(), -1);
+    StaveOrder order{staves, std::vector<int>(staves.size(), -1), {}};
+    std::vector<MountBody> staveBodies;
     for (size_t k = 0; k < staves.size(); ++k)
-        bodies.list.push_back(
-            staveBody(staves[k], input, sweeps.frameToGridMm(), maxPerPiece, &staveHoles[k]));
+        staveBodies.push_back(
+            staveBody(staves[k], input, sweeps.frameToGridMm(), maxPerPiece, &order.holes[k]));
+    for (size_t k : glueStavesInPlace(order, input, faces, sweeps.frameToGridMm(), voxelMm))
+        bodies.list.push_back(std::move(staveBodies[k]));
     const size_t fixed = staves.size();
-    // A stave no hole holds leaves no plan to be carried out: the frame must grow toward it first
-    // (growFrameForStaves), and an order of the rest is not sought (the cheese at 700 mm: minutes).
-    if (std::count(staveHoles.begin(), staveHoles.end(), -1) > 0)
-        return unheldStavesPlan(input, staves, staveHoles, sweeps.frameToGridMm());
+    // A stave no hole holds and none of its ring holds it either leaves no plan to be carried out:
+    // the frame must grow toward it first (growFrameForStaves), and an order of the rest is not
+    // sought (the cheese at 700 mm: minutes).
+    if (std::count(order.holes.begin(), order.holes.end(), -1) > 0)
+        return unheldStavesPlan(input, order, sweeps.frameToGridMm());
     SweepCache cache;
     const GlueOnRule glueOn;
     Disassembly parts =
@@ -586,9 +590,9 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
         fewestStuck = std::min(fewestStuck, parts.stuck.size());
     }
     const size_t firstStave = bodies.list.size() - fixed;
-    for (size_t k = 0; k < fixed; ++k) parts.holes[firstStave + k] = staveHoles[k];
+    for (size_t k = 0; k < fixed; ++k) parts.holes[firstStave + k] = order.holes[k];
     mount::InstallationPlan plan = writePlan(bodies, parts, input.pieces.size(), fixed);
-    addStaveSteps(plan, input, staves, staveHoles, sweeps.frameToGridMm());
+    addStaveSteps(plan, input, order, sweeps.frameToGridMm());
     return plan;
 }
 

@@ -18,8 +18,6 @@ namespace zomefab::pieces::detail {
 namespace {
 
 constexpr double kFarMm = 1e9;  // the core distance off a prism's raster
-/// A staved lining at a mouth no longer than this many walls stays one ring (cutStaves).
-constexpr double kMouthRingWalls = 3.0;
 
 /// Per grid axis, which prism's lines each column lies on: the nearest core of that axis whose
 /// prism's radius reaches the column (ties: the lowest index), over the field's columns.
@@ -150,6 +148,42 @@ double TunnelPrism::signedDistanceMm(const Vec3d& x) const {
         (1 - su) * sv * columnDistanceMm(iu, iv + 1) + su * sv * columnDistanceMm(iu + 1, iv + 1);
     const double t = x[size_t(axis)];
     return std::max({d - radiusMm, loMm - t, t - hiMm});
+}
+
+double TunnelPrism::splitMm() const {
+    const double middle = 0.5 * (loMm + hiMm);
+    double best = middle, far = std::numeric_limits<double>::infinity();
+    for (const auto& [t, r] : crossingsMm)
+        if (std::abs(t - middle) < far - 1e-9) far = std::abs(t - middle), best = t;
+    return best;
+}
+
+namespace {
+
+/// The centre of @p p's core along grid axis @p a (its own axis excluded).
+double centreAlong(const TunnelPrism& p, int a) { return a == (p.axis + 1) % 3 ? p.centerUMm : p.centerVMm; }
+
+}  // namespace
+
+void markCrossings(std::vector<TunnelPrism>& prisms) {
+    for (TunnelPrism& p : prisms) {
+        std::vector<std::pair<double, double>> list;
+        for (const TunnelPrism& q : prisms) {
+            if (q.axis == p.axis || !q.isStaved) continue;
+            const int c = 3 - p.axis - q.axis;  // the third axis
+            const double t = centreAlong(q, p.axis), b = centreAlong(p, q.axis);
+            if (std::abs(centreAlong(p, c) - centreAlong(q, c)) <= p.coreRadiusMm && t >= p.loMm &&
+                t <= p.hiMm && b >= q.loMm && b <= q.hiMm)
+                list.push_back({t, q.coreRadiusMm});
+        }
+        std::sort(list.begin(), list.end());
+        p.crossingsMm.clear();
+        for (const auto& [t, r] : list)  // the tunnels of both other axes cross at one point
+            if (!p.crossingsMm.empty() && t - p.crossingsMm.back().first <= p.voxelMm)
+                p.crossingsMm.back().second = std::max(p.crossingsMm.back().second, r);
+            else
+                p.crossingsMm.push_back({t, r});
+    }
 }
 
 const TunnelPrism* ownPrism(const CellSet& set) {
@@ -366,7 +400,7 @@ size_t cutRings(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelFie
 }  // namespace
 
 size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
-                            const GridCells& cells, double wallMm, double frameDMinMm,
+                            const GridCells& cells, double wallMm, double frameDMinMm, double thinGapMm,
                             double minPieceVolumeMm3, const RunContext& context) {
     std::vector<CellSet>& sets = grouping.cellSets;
     // A wall and two voxels: the shell's voxels reach a voxel past the wall (φ < 0 at their
@@ -377,8 +411,10 @@ size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, Voxe
     const std::vector<TunnelPrism> found =
         crossingPrisms(field, 2.0 * wallMm, radiusMm, wallMm + field.voxelMm, &isTriple, true);
     if (found.empty()) return 0;
+    std::vector<TunnelPrism> marked = found;
+    if (isTriple) markCrossings(marked);
     std::vector<std::shared_ptr<const TunnelPrism>> prisms;
-    for (const TunnelPrism& p : found) prisms.push_back(std::make_shared<const TunnelPrism>(p));
+    for (const TunnelPrism& p : marked) prisms.push_back(std::make_shared<const TunnelPrism>(p));
     const std::vector<uint32_t> prismOf = prismOwners(field, found, isTriple);
     const size_t oldCount = pieces.size();
     const size_t carved = carveParts(pieces, sets, field, prisms, prismOf, isTriple).size();
@@ -394,9 +430,7 @@ size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, Voxe
     ownBand(field, prismOf, isLining);
     const size_t joined = joinRemnants(pieces, sets, field, cells, minPieceVolumeMm3);
     if (isTriple) {
-        // A mouth's lining no longer than three walls lies within the face's wall and the
-        // crossing's prisms: no ball behind it (the cheese at 700 mm: 34 mm, 85 staves unheld).
-        cutStaves(pieces, sets, field, kMouthRingWalls * wallMm);
+        cutStaves(pieces, sets, field, wallMm, thinGapMm);
         dropEmptyPieces(pieces, sets, field);
         grouping.faces = faceContacts(field, cells, sets, pieces);
         const size_t staves = size_t(std::count_if(sets.begin(), sets.end(), isStaveSet));

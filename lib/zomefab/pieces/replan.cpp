@@ -48,7 +48,11 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
         candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);
     out.plan = planOverCandidates(out, field, grouping, sweeps, candidates, lost, opt, context, preGlued);
     auto underHeldAfter = [&] {
-        if (kind == Change::kStaves) return unheldStaves(out.plan.holeOfPiece, grouping.cellSets);
+        // Staves no peg holds; a plan that could be carried out must stay so.
+        if (kind == Change::kStaves)
+            return kept.plan.isBuildable() && !out.plan.isBuildable()
+                       ? SIZE_MAX
+                       : peglessStaves(out.plan, grouping.cellSets);
         return !out.plan.isBuildable() ? SIZE_MAX : steps ? underHeldStepsNow() : underHeldNow();
     };
     size_t after = underHeldAfter();
@@ -58,7 +62,7 @@ std::optional<size_t> Replanner::tryChange(const std::function<void()>& change, 
         after = underHeldAfter();
     }
     context.debug("mounting: " + what + ": " +
-                  (kind == Change::kStaves ? std::string("staves placed nowhere")
+                  (kind == Change::kStaves ? std::string("staves no peg holds")
                                            : (steps ? "steps" : "pieces") + std::string(" under ") +
                                                  std::to_string(opt.tenons.minPerPiece) + " pegs") +
                   " " + std::to_string(before) + " -> " +

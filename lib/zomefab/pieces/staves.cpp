@@ -3,6 +3,7 @@
 #include "zomefab/pieces/detail/staves.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -10,11 +11,71 @@
 #include "zomefab/core/format.h"
 #include "zomefab/pieces/detail/mounting.h"
 #include "zomefab/pieces/detail/splits.h"
+#include "zomefab/zome/zome_system.h"
 
 namespace zomefab::pieces::detail {
 
-size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field,
-                 double maxMouthRingMm) {
+std::array<Vec3d, 4> staveLifts(int axis, bool isTurned) {
+    Vec3d u{0, 0, 0}, v{0, 0, 0};
+    u[size_t(axis + 1) % 3] = 1.0, v[size_t(axis + 2) % 3] = 1.0;
+    if (isTurned) {
+        const double h = std::sqrt(0.5);
+        const Vec3d du = scale(add(u, v), h), dv = scale(sub(v, u), h);
+        u = du, v = dv;
+    }
+    return {u, scale(u, -1.0), v, scale(v, -1.0)};
+}
+
+namespace {
+
+/// A point on the axis of @p prism (grid mm).
+Vec3d axisPoint(const TunnelPrism& prism) {
+    Vec3d c{0, 0, 0};
+    c[size_t(prism.axis + 1) % 3] = prism.centerUMm, c[size_t(prism.axis + 2) % 3] = prism.centerVMm;
+    return c;
+}
+
+/// How many of the four staves of lining @p p (its slots @p slots, its prism @p prism), cut square
+/// to the grid or turned (@p isTurned), would lie under a wall too thin for a ball: each inside
+/// voxel counted with the stave whose lift it lies farthest along from the axis.
+size_t thinStaveCount(const VoxelField& field, const std::vector<size_t>& slots, uint32_t p,
+                      const TunnelPrism& prism, bool isTurned, double thinGapMm) {
+    const std::array<Vec3d, 4> lifts = staveLifts(prism.axis, isTurned);
+    const Vec3d c = axisPoint(prism);
+    std::array<std::vector<Vec3d>, 4> sectors;
+    for (size_t s : slots) {
+        if (!field.isInside(s)) continue;
+        const Vec3d x = field.world(field.coordOf(s)), r = sub(x, c);
+        size_t best = 0;
+        for (size_t k = 1; k < 4; ++k)
+            if (dot(r, lifts[k]) > dot(r, lifts[best])) best = k;
+        sectors[best].push_back(x);
+    }
+    size_t thin = 0;
+    for (size_t k = 0; k < 4; ++k) {
+        Stave st;
+        st.liftGrid = lifts[k];
+        thin += staveUnderThinWall(st, p, sectors[k], field, thinGapMm) ? 1 : 0;
+    }
+    return thin;
+}
+
+}  // namespace
+
+bool isMouthRingExtent(const TunnelPrism& prism, double loMm, double hiMm, double voxelMm, double wallMm,
+                       double thinGapMm) {
+    const bool isAtLo = loMm <= prism.loMm + 2.0 * voxelMm, isAtHi = hiMm >= prism.hiMm - 2.0 * voxelMm;
+    if (!isAtLo && !isAtHi) return false;
+    if (hiMm - loMm <= kMouthRingWalls * wallMm) return true;
+    if (prism.crossingsMm.empty()) return false;
+    const auto& [at, radius] = isAtLo ? prism.crossingsMm.front() : prism.crossingsMm.back();
+    const bool isBefore = isAtLo ? hiMm < at : loMm > at;
+    const double faceToAxisMm = isAtLo ? at - prism.loMm : prism.hiMm - at;
+    return isBefore && faceToAxisMm - radius - 2.0 * wallMm < thinGapMm;
+}
+
+size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field, double wallMm,
+                 double thinGapMm) {
     std::vector<std::vector<size_t>> slots = slotsOfPieces(field, pieces.size());
     size_t cuts = 0;
     auto split = [&](uint32_t p, const Vec3d& normal, double offsetMm) {
@@ -30,26 +91,35 @@ size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelFi
         const TunnelPrism* prism = sets[p].isLining ? ownPrism(sets[p]) : nullptr;
         if (!prism || !prism->isStaved) continue;
         const int a = prism->axis;
-        Vec3d axis{0, 0, 0}, u{0, 0, 0}, v{0, 0, 0};
-        axis[size_t(a)] = 1.0, u[size_t(a + 1) % 3] = 1.0, v[size_t(a + 2) % 3] = 1.0;
-        const double middle = 0.5 * (prism->loMm + prism->hiMm);
+        Vec3d axis{0, 0, 0};
+        axis[size_t(a)] = 1.0;
+        const double splitAt = prism->splitMm();  // each side slides out of its own mouth
+        // Cut where tunnels cross it (three round tunnels of one size leave corner bits there at
+        // most) and where it is split: segments, each between crossings or a crossing and a mouth.
+        std::vector<double> planes{splitAt};
+        for (const auto& [t, r] : prism->crossingsMm) planes.push_back(t);
         if (const auto [lo, hi] = extentAlong(field, slots[p], a);
-            hi - lo <= maxMouthRingMm &&
-            (lo <= prism->loMm + 2.0 * field.voxelMm || hi >= prism->hiMm - 2.0 * field.voxelMm)) {
-            sets[p].isMouthRing = true;
-            sets[p].ringDepthMm = hi - lo;
-            continue;
-        }
-        std::vector<uint32_t> halves{p};
-        if (const auto [lo, hi] = extentAlong(field, slots[p], a); lo < middle && hi > middle)
-            halves.push_back(split(p, axis, middle));
+            isMouthRingExtent(*prism, lo, hi, field.voxelMm, wallMm, thinGapMm))
+            planes.clear();  // a lining from mouth to mouth as short as a mouth ring stays whole
+        std::sort(planes.begin(), planes.end());
+        std::vector<uint32_t> segments{p};
+        for (double t : planes)
+            if (const auto [lo, hi] = extentAlong(field, slots[segments.back()], a); lo < t && hi > t)
+                segments.push_back(split(segments.back(), axis, t));
         std::vector<uint32_t> rings;
-        for (uint32_t h : halves) {
-            const auto [lo, hi] = extentAlong(field, slots[h], a);
+        for (uint32_t g : segments) {
+            const auto [lo, hi] = extentAlong(field, slots[g], a);
             if (!(lo <= hi)) continue;
-            const bool isHigh = lo + hi > 2.0 * middle;  // slides out of the mouth at the high end
+            if (isMouthRingExtent(*prism, lo, hi, field.voxelMm, wallMm, thinGapMm)) {
+                sets[g].isMouthRing = true;
+                sets[g].ringDepthMm = hi - lo;
+                continue;
+            }
+            sets[g].isStaveTurned = thinStaveCount(field, slots[g], g, *prism, true, thinGapMm) <
+                                    thinStaveCount(field, slots[g], g, *prism, false, thinGapMm);
+            const bool isHigh = lo + hi > 2.0 * splitAt;  // slides out of the mouth at the high end
             const int count = int(std::ceil((hi - lo) / kStaveRingMm));
-            std::vector<uint32_t> along{h};
+            std::vector<uint32_t> along{g};
             for (int k = 1; k < count; ++k)
                 along.push_back(split(along.back(), axis, lo + (hi - lo) * k / count));
             for (size_t k = 0; k < along.size(); ++k) {
@@ -60,11 +130,15 @@ size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelFi
                 rings.push_back(along[k]);
             }
         }
+        // The side staves across su, then top and bottom across sv (square to the grid or turned).
         const double off = std::sqrt(0.5) * prism->coreRadiusMm;
         for (uint32_t r : rings) {
-            split(r, u, prism->centerUMm + off);
-            split(r, scale(u, -1.0), off - prism->centerUMm);
-            split(r, v, prism->centerVMm);
+            const std::array<Vec3d, 4> lifts = staveLifts(a, sets[r].isStaveTurned);
+            const Vec3d su = lifts[0], sv = lifts[2], c = axisPoint(*prism);
+            const double cu = dot(su, c), cv = dot(sv, c);
+            split(r, su, cu + off);
+            split(r, scale(su, -1.0), off - cu);
+            split(r, sv, cv);
         }
     }
     return cuts;
@@ -91,7 +165,7 @@ bool staveUnderThinWall(const Stave& stave, uint32_t p, const std::vector<Vec3d>
 
 size_t noteUnheldStaves(Pieces& out, const std::vector<CellSet>& sets, const VoxelField& field,
                         double thinGapMm) {
-    const size_t unheld = unheldStaves(out.plan.holeOfPiece, sets);
+    const size_t unheld = unplacedStaves(out.plan.holeOfPiece, sets);
     if (unheld == 0) return 0;
     const size_t staves = size_t(std::count_if(sets.begin(), sets.end(), isStaveSet));
     std::vector<std::vector<Vec3d>> voxels(out.pieces.size());
@@ -115,8 +189,9 @@ size_t noteUnheldStaves(Pieces& out, const std::vector<CellSet>& sets, const Vox
             std::to_string(staves) + " staves lining them have no peg to hold them" + under +
             ": no ball's hole behind the wall points at the stave within a tenon's reach along a direction "
             "it can be lifted along (square to its seams, not back toward the staves deeper in), or another "
-            "stave's tenon took it; partitioning again leaves the same tunnels and frame (docs/mounting.md, "
-            "\"Three tunnels through one point\")");
+            "stave's tenon took it, and no stave of its ring that a peg holds shares a seam with it to glue "
+            "it onto; partitioning again leaves the same tunnels and frame (docs/mounting.md, \"Three "
+            "tunnels through one point\")");
     out.crossingTunnelPieces = unheld;
     return unheld;
 }
@@ -133,48 +208,48 @@ bool isStaveDirection(const Stave& stave, const Vec3d& d) {
     // 1.4 mm, within the prism's two voxels past the wall.
     const double sinSlack = std::sin(2.0 * kPi / 180.0);
     const Vec3d across = cross(stave.slideGrid, stave.liftGrid);  // round the axis
-    return dot(d, stave.liftGrid) <= -std::cos(35.0 * kPi / 180.0) && dot(d, stave.slideGrid) >= -sinSlack &&
-           std::abs(dot(d, across)) <= sinSlack;
+    return dot(d, stave.liftGrid) <= -std::cos(kStaveLeanDeg * kPi / 180.0) &&
+           dot(d, stave.slideGrid) >= -sinSlack && std::abs(dot(d, across)) <= sinSlack;
 }
 
 std::optional<Stave> staveOf(const CellSet& set, const std::vector<Vec3d>& voxelsMm) {
     if (!isStaveSet(set) || voxelsMm.empty()) return std::nullopt;
     const TunnelPrism* prism = ownPrism(set);
     const int a = prism->axis;
-    const size_t u = size_t(a + 1) % 3, v = size_t(a + 2) % 3;
+    const std::array<Vec3d, 4> lifts = staveLifts(a, set.isStaveTurned);
     Vec3d mean{0, 0, 0};
     for (const Vec3d& x : voxelsMm) mean = add(mean, x);
     mean = scale(mean, 1.0 / double(voxelsMm.size()));
-    const double du = mean[u] - prism->centerUMm, dv = mean[v] - prism->centerVMm;
-    const double slide = 2.0 * mean[size_t(a)] >= prism->loMm + prism->hiMm ? 1.0 : -1.0;
+    const Vec3d r = sub(mean, axisPoint(*prism));
+    const double du = dot(r, lifts[0]), dv = dot(r, lifts[2]);
+    const double slide = mean[size_t(a)] >= prism->splitMm() ? 1.0 : -1.0;
     const bool isSide = std::abs(du) >= std::abs(dv);
     const double lift = (isSide ? du : dv) >= 0 ? 1.0 : -1.0;
     Stave st;
     st.slideGrid[size_t(a)] = slide;
-    st.liftGrid[isSide ? u : v] = lift;
-    st.seamGrid[u] = 1.0;
+    st.liftGrid = scale(lifts[isSide ? 0 : 2], lift);
+    st.seamGrid = lifts[0];
     st.isSide = isSide;
     st.rank = {a, prism->centerUMm, prism->centerVMm, slide, -set.ringDepthMm, isSide ? 0 : 1, lift};
     return st;
 }
 
-void setStaveLifts(Pieces& out, const VoxelField& field, const Transform4d& frameToGridMm,
-                   double frameDMinMm) {
+void setStaveLifts(Pieces& out, const std::vector<CellSet>& sets, const VoxelField& field,
+                   const Transform4d& frameToGridMm, double frameDMinMm) {
     std::vector<int> stepOf(out.pieces.size(), -1);
     std::vector<Vec3d> wallOut(out.pieces.size(), Vec3d{0, 0, 0});  // across the wall, out of the tunnel
     for (size_t s = 0; s < out.plan.steps.size(); ++s) {
         const mount::MountStep& step = out.plan.steps[s];
         if (!step.hasTwoLegs()) continue;
         const uint32_t p = step.pieces[0];
-        stepOf[p] = int(s);
         const Vec3d in = gridDirection(step.hole, frameToGridMm);
-        const Vec3d slide = normalized(applyLinear(frameToGridMm, step.slide));
-        size_t best = 0;
-        for (size_t k = 1; k < 3; ++k)
-            if (std::abs(in[k]) * (1.0 - std::abs(slide[k])) >
-                std::abs(in[best]) * (1.0 - std::abs(slide[best])))
-                best = k;
-        wallOut[p][best] = in[best] > 0 ? -1.0 : 1.0;
+        const TunnelPrism* prism = p < sets.size() ? ownPrism(sets[p]) : nullptr;
+        if (!prism) continue;  // a stave's step: not reached
+        stepOf[p] = int(s);
+        const std::array<Vec3d, 4> lifts = staveLifts(prism->axis, sets[p].isStaveTurned);
+        wallOut[p] = *std::max_element(lifts.begin(), lifts.end(), [&](const Vec3d& x, const Vec3d& y) {
+            return dot(x, in) > dot(y, in);  // the most against the direction
+        });
     }
     std::vector<double> nearest(out.pieces.size(), std::numeric_limits<double>::infinity());
     for (size_t s = 0; s < field.phi.size(); ++s) {
@@ -210,41 +285,120 @@ MountBody staveBody(uint32_t p, const PlannerInput& input, const Transform4d& fr
     return body;
 }
 
-void addStaveSteps(mount::InstallationPlan& plan, const PlannerInput& input,
-                   const std::vector<uint32_t>& staves, const std::vector<int>& holes,
+std::vector<size_t> glueStavesInPlace(StaveOrder& order, const PlannerInput& input, const FaceContacts& faces,
+                                      const Transform4d& frameToGridMm, double voxelMm) {
+    const size_t n = order.pieces.size();
+    order.hosts.assign(n, {});
+    const GlueOnRule rule;
+    // A ring: the rank's axis, tunnel, mouth and depth (the staves come in rank order: rings in runs).
+    auto ringOf = [&](size_t k) {
+        const auto& r = input.staves[order.pieces[k]]->rank;
+        return std::make_tuple(std::get<0>(r), std::get<1>(r), std::get<2>(r), std::get<3>(r),
+                               std::get<4>(r));
+    };
+    auto sharesSeam = [&](uint32_t p, uint32_t q) {
+        const auto it = faces.find({std::min(p, q), std::max(p, q)});
+        size_t voxelFaces = 0;
+        if (it != faces.end())
+            for (const CutContact& c : it->second) voxelFaces += c.voxelFaces;
+        return rule.isLargeEnough(voxelFaces, voxelMm);
+    };
+    auto holeAlong = [&](uint32_t p) {  // along its slide: it is taken off out of its mouth, straight
+        for (int h = 0; h < zome::kHoleCount; ++h)
+            if (dot(gridDirection(h, frameToGridMm), input.staves[p]->slideGrid) > std::cos(kPi / 180.0))
+                return h;
+        return -1;
+    };
+    std::vector<size_t> perm;  // the new order, old indices: ring by ring, held staves, then glued ones
+    std::vector<uint8_t> isOn(n, 0);
+    for (size_t begin = 0, end = 0; begin < n; begin = end) {
+        while (end < n && ringOf(end) == ringOf(begin)) ++end;
+        for (size_t k = begin; k < end; ++k)
+            if (order.holes[k] >= 0) perm.push_back(k), isOn[k] = 1;
+        // A stave glued in place may hold the next (a chain round the ring).
+        for (bool isGrown = true; isGrown;) {
+            isGrown = false;
+            for (size_t k = begin; k < end; ++k) {
+                const uint32_t p = order.pieces[k];
+                const int along = isOn[k] ? -1 : holeAlong(p);
+                if (along < 0) continue;
+                for (size_t j : perm)
+                    if (sharesSeam(p, order.pieces[j])) order.hosts[k].push_back(order.pieces[j]);
+                if (order.hosts[k].empty()) continue;
+                order.holes[k] = along;
+                perm.push_back(k), isOn[k] = 1, isGrown = true;
+            }
+        }
+        for (size_t k = begin; k < end; ++k)
+            if (!isOn[k]) perm.push_back(k);
+    }
+    StaveOrder sorted;
+    for (size_t k : perm) {
+        sorted.pieces.push_back(order.pieces[k]);
+        sorted.holes.push_back(order.holes[k]);
+        sorted.hosts.push_back(order.hosts[k]);
+    }
+    order = std::move(sorted);
+    return perm;
+}
+
+void addStaveSteps(mount::InstallationPlan& plan, const PlannerInput& input, const StaveOrder& order,
                    const Transform4d& frameToGridMm) {
     std::vector<mount::MountStep> steps;
     const Transform4d gridToFrame = affineInverse(frameToGridMm);
-    for (size_t k = 0; k < staves.size(); ++k) {
-        const uint32_t p = staves[k];
-        if (holes[k] < 0) {
+    for (size_t k = 0; k < order.pieces.size(); ++k) {
+        const uint32_t p = order.pieces[k];
+        if (order.holes[k] < 0) {
             plan.problems.push_back("piece " + std::to_string(p) +
                                     ", a stave lining a tunnel: no ball's hole behind its wall points at it "
-                                    "within a tenon's reach");
+                                    "within a tenon's reach, and it shares no seam with a stave of its ring "
+                                    "that one holds to be glued onto");
+            continue;
+        }
+        if (k < order.hosts.size() && !order.hosts[k].empty()) {
+            // Glued in place: slid straight along its tunnel, along the seams of its hosts.
+            steps.push_back({{p}, order.holes[k]});
+            for (uint32_t host : order.hosts[k]) plan.gluedOn.push_back({host, p});
             continue;
         }
         const Vec3d slide = normalized(applyLinear(gridToFrame, input.staves[p]->slideGrid));
-        steps.push_back({{p}, holes[k], slide, kStaveLiftMm});
+        steps.push_back({{p}, order.holes[k], slide, kStaveLiftMm});
     }
+    std::sort(plan.gluedOn.begin(), plan.gluedOn.end());
     if (plan.isBuildable()) plan.steps.insert(plan.steps.begin(), steps.begin(), steps.end());
 }
 
-mount::InstallationPlan unheldStavesPlan(const PlannerInput& input, const std::vector<uint32_t>& staves,
-                                         const std::vector<int>& holes, const Transform4d& frameToGridMm) {
+mount::InstallationPlan unheldStavesPlan(const PlannerInput& input, const StaveOrder& order,
+                                         const Transform4d& frameToGridMm) {
     mount::InstallationPlan plan;
     plan.holeOfPiece.assign(input.pieces.size(), -1);
     plan.groupOf.resize(input.pieces.size());
     for (uint32_t p = 0; p < input.pieces.size(); ++p) plan.groupOf[p] = p;
-    for (size_t k = 0; k < staves.size(); ++k) plan.holeOfPiece[staves[k]] = holes[k];
-    addStaveSteps(plan, input, staves, holes, frameToGridMm);
+    for (size_t k = 0; k < order.pieces.size(); ++k) plan.holeOfPiece[order.pieces[k]] = order.holes[k];
+    addStaveSteps(plan, input, order, frameToGridMm);
     return plan;
 }
 
-size_t unheldStaves(const std::vector<int>& holeOfPiece, const std::vector<CellSet>& sets) {
+size_t unplacedStaves(const std::vector<int>& holeOfPiece, const std::vector<CellSet>& sets) {
     size_t unheld = 0;
     for (size_t p = 0; p < sets.size() && p < holeOfPiece.size(); ++p)
         unheld += holeOfPiece[p] < 0 && isStaveSet(sets[p]) ? 1 : 0;
     return unheld;
+}
+
+bool isGluedOn(const mount::InstallationPlan& plan, uint32_t p) {
+    return std::any_of(plan.gluedOn.begin(), plan.gluedOn.end(),
+                       [&](const auto& e) { return e.second == p; });
+}
+
+size_t peglessStaves(const mount::InstallationPlan& plan, const std::vector<CellSet>& sets) {
+    std::vector<uint8_t> isGlued(sets.size(), 0);
+    for (const auto& [host, p] : plan.gluedOn)
+        if (p < isGlued.size()) isGlued[p] = 1;
+    size_t count = 0;
+    for (size_t p = 0; p < sets.size() && p < plan.holeOfPiece.size(); ++p)
+        count += (plan.holeOfPiece[p] < 0 || isGlued[p]) && isStaveSet(sets[p]) ? 1 : 0;
+    return count;
 }
 
 }  // namespace zomefab::pieces::detail

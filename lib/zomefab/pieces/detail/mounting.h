@@ -146,18 +146,36 @@ MountBody makeBody(const std::vector<uint32_t>& members, const PlannerInput& inp
 MountBody staveBody(uint32_t p, const PlannerInput& input, const Transform4d& frameToGridMm, int maxPerPiece,
                     int* hole);
 
-/// The steps of @p staves (pieces, in their order; @p holes their directions, −1: none) put before
-/// @p plan's, each slid in along its tunnel and held kStaveLiftMm off its place; a stave with no
-/// direction is a problem of the plan instead.
-void addStaveSteps(mount::InstallationPlan& plan, const PlannerInput& input,
-                   const std::vector<uint32_t>& staves, const std::vector<int>& holes,
+/// The staves of a plan in their mounting order, each one's direction (its hole; −1: none) and, for
+/// a stave no peg holds that is glued in place (glueStavesInPlace), the staves it is glued onto.
+struct StaveOrder {
+    std::vector<uint32_t> pieces;
+    std::vector<int> holes;
+    std::vector<std::vector<uint32_t>> hosts;  ///< per stave; empty: its pegs hold it
+};
+
+/// Staves no hole holds (−1 in @p order.holes) that share a seam or a ring's cut face large enough to
+/// glue across (GlueOnRule) with staves on before them are glued in place onto those: such a stave
+/// slides along its tunnel straight to its place, along its ring's seams, after the staves of its
+/// ring that holes hold (and after those glued in place it is glued onto: a chain round the ring);
+/// its hole is the one along its slide, out of its mouth (none there: it stays unheld). The staves
+/// keep their rank's order of rings; in a ring those holes hold come first, in rank order, then the
+/// glued ones as they were found, then those still unheld. Returns the permutation applied (the new
+/// k-th stave is the old result[k]).
+std::vector<size_t> glueStavesInPlace(StaveOrder& order, const PlannerInput& input, const FaceContacts& faces,
+                                      const Transform4d& frameToGridMm, double voxelMm);
+
+/// The steps of @p order's staves put before @p plan's: each slid in along its tunnel and held
+/// kStaveLiftMm off its place, or, glued in place, slid straight to it (its hosts glued on); a
+/// stave with no direction is a problem of the plan instead.
+void addStaveSteps(mount::InstallationPlan& plan, const PlannerInput& input, const StaveOrder& order,
                    const Transform4d& frameToGridMm);
 
-/// The plan when staves have no direction (−1 in @p holes): the staves' steps and a problem for each
-/// stave no hole holds; every other piece placed nowhere (no order is sought for them: the frame
-/// must grow toward the staves first).
-mount::InstallationPlan unheldStavesPlan(const PlannerInput& input, const std::vector<uint32_t>& staves,
-                                         const std::vector<int>& holes, const Transform4d& frameToGridMm);
+/// The plan when staves have no direction (−1 in @p order.holes): the staves' steps and a problem
+/// for each stave no hole holds; every other piece placed nowhere (no order is sought for them: the
+/// frame must grow toward the staves first).
+mount::InstallationPlan unheldStavesPlan(const PlannerInput& input, const StaveOrder& order,
+                                         const Transform4d& frameToGridMm);
 
 /// Hole @p hole's direction in the grid's mm (unit).
 Vec3d gridDirection(int hole, const Transform4d& frameToGridMm);

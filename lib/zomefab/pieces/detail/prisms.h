@@ -45,6 +45,14 @@ struct TunnelPrism {
     bool isStaved = false;
     double centerUMm = 0.0, centerVMm = 0.0;  ///< the core's middle across the axis (grid mm)
     double coreRadiusMm = 0.0;                ///< half the core's extent across the axis
+    /// Where the staved prisms of other axes cross it (grid mm along its axis, in order), each with
+    /// the largest radius of the cores crossing there (markCrossings).
+    std::vector<std::pair<double, double>> crossingsMm;
+
+    /// Where its lining is cut in two, each half sliding out of its own mouth (grid mm): of the
+    /// crossings (where three tunnels cross the lining is broken anyway) the one nearest its middle,
+    /// the lower on a tie; its middle when none is known.
+    double splitMm() const;
 
     /// The core distance of column (u, v); a far value off the raster.
     double columnDistanceMm(int u, int v) const;
@@ -74,6 +82,10 @@ std::vector<uint32_t> prismOwners(const VoxelField& field, const std::vector<Tun
 std::vector<TunnelPrism> crossingPrisms(const VoxelField& field, double minDiameterMm, double radiusMm,
                                         double endMm, bool* isTriple, bool isStaving = false);
 
+/// Sets every staved prism's crossings (TunnelPrism::crossingsMm): a prism of another axis whose
+/// core's middle lies within this one's core radius across both, and between the ends of both.
+void markCrossings(std::vector<TunnelPrism>& prisms);
+
 /// The prism a lining's cell set keeps inside, or null.
 const TunnelPrism* ownPrism(const CellSet& set);
 
@@ -91,9 +103,10 @@ std::pair<double, double> extentAlong(const VoxelField& field, const std::vector
 /// many pieces line the tunnels (0: nothing changed). Where three tunnels cross at one point the
 /// prisms are staved: a later axis keeps the shell where they overlap, each lining is cut at its
 /// tunnel's middle, into rings, and each ring into four staves by planes along the axis at ±√½ of
-/// the core's radius across u and at the middle across v (Stave).
+/// the core's radius across u and at the middle across v (Stave), or turned 45° about the axis
+/// where fewer staves then lie under a wall too thin for a ball (@p thinGapMm, cutStaves).
 size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
-                            const GridCells& cells, double wallMm, double frameDMinMm,
+                            const GridCells& cells, double wallMm, double frameDMinMm, double thinGapMm,
                             double minPieceVolumeMm3, const RunContext& context);
 
 }  // namespace zomefab::pieces::detail

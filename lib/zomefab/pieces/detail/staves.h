@@ -7,6 +7,7 @@
 /// one point".
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <optional>
 #include <tuple>
@@ -40,8 +41,13 @@ struct Stave {
 /// ridges alone are narrow, takes wall behind which balls lie; short enough for a printer's bed.
 inline constexpr double kStaveRingMm = 160.0;
 
+/// How far a stave's direction may lean along its axis off its lift (degrees): the red and yellow
+/// holes beside a lift square to the grid (31.7°, 20.9°), and the yellow holes (±1, ±1, ±1) beside a
+/// lift along a diagonal of a turned ring (35.26°).
+inline constexpr double kStaveLeanDeg = 36.0;
+
 /// Whether a stave may take the direction @p d (grid, unit; the hole's, toward the tunnel's axis):
-/// within 35° of its lift reversed, leaning only along the axis and not back toward the deeper
+/// within kStaveLeanDeg of its lift reversed, leaning only along the axis and not back toward the deeper
 /// rings, which are on. Leaning round the axis, its lift (up to a stem's length) would carry a top
 /// stave across its seams into the side staves, which are on, and a side stave's edges out of the
 /// prism past the corners, into the frame.
@@ -68,7 +74,13 @@ bool staveUnderThinWall(const Stave& stave, uint32_t p, const std::vector<Vec3d>
                         const VoxelField& field, double thinGapMm);
 
 /// How many staves (@p sets) a plan places nowhere (@p holeOfPiece −1).
-size_t unheldStaves(const std::vector<int>& holeOfPiece, const std::vector<CellSet>& sets);
+size_t unplacedStaves(const std::vector<int>& holeOfPiece, const std::vector<CellSet>& sets);
+
+/// Whether @p plan glues piece @p p on (a stave glued in place: no peg holds it).
+bool isGluedOn(const mount::InstallationPlan& plan, uint32_t p);
+
+/// How many staves (@p sets) no peg holds in @p plan: placed nowhere or glued in place.
+size_t peglessStaves(const mount::InstallationPlan& plan, const std::vector<CellSet>& sets);
 
 /// Whether @p set's piece lines a staved prism: a stave or a mouth ring (CellSet::isMouthRing).
 bool isStavedLining(const CellSet& set);
@@ -77,20 +89,40 @@ bool isStavedLining(const CellSet& set);
 /// re-cut may cut across its seams.
 bool isStaveSet(const CellSet& set);
 
+/// The four ways the staves of a ring of a lining along grid axis @p axis are lifted (grid, unit):
+/// +u, −u (the side staves), +v, −v (top and bottom), u and v the next grid axes, or their
+/// diagonals (u + v)/√2 and (v − u)/√2 when @p isTurned.
+std::array<Vec3d, 4> staveLifts(int axis, bool isTurned);
+
 /// The stave @p set's piece is (its voxels' centres @p voxelsMm, grid mm), or none for a piece that
 /// lines no staved prism.
 std::optional<Stave> staveOf(const CellSet& set, const std::vector<Vec3d>& voxelsMm);
 
-/// Every lining of a staved prism cut at its tunnel's middle (each half slides out of its own
-/// mouth), each half into equal rings no longer than kStaveRingMm, each ring into four staves:
-/// across u at ±√½ of the core's radius (the side staves, whose seams are across their lift), then
-/// across v at the middle (top and bottom, sliding along the side staves' seams as they are lifted).
-/// A lining that reaches its mouth and is no longer than @p maxMouthRingMm (between the mouth and
-/// the first crossing: behind it lies only the face's wall, no ball) stays one ring, a mouth ring
-/// (CellSet::isMouthRing). Sets each ring's depth (CellSet::ringDepthMm). Returns how many cuts;
-/// pieces the cuts left empty are the caller's to drop.
-size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field,
-                 double maxMouthRingMm);
+/// A staved lining at a mouth no longer than this many walls stays one ring (cutStaves).
+inline constexpr double kMouthRingWalls = 3.0;
+
+/// Whether a lining of @p prism whose voxels' centres lie between @p loMm and @p hiMm along its axis
+/// stays one mouth ring: it reaches a mouth and is no longer than kMouthRingWalls walls (@p wallMm),
+/// or ends before the first crossing from that mouth while the hollow between the face's wall and
+/// that crossing tunnel's wall is too thin for a ball (@p thinGapMm): the cheese at 700 mm, 87.5 mm
+/// from a face to the axis of a crossing 88 mm across, 11.5 mm of hollow.
+bool isMouthRingExtent(const TunnelPrism& prism, double loMm, double hiMm, double voxelMm, double wallMm,
+                       double thinGapMm);
+
+/// Every lining of a staved prism cut where its tunnel is split (TunnelPrism::splitMm: each half
+/// slides out of its own mouth) and where tunnels cross it (TunnelPrism::crossingsMm), each segment
+/// into equal rings no longer than kStaveRingMm, each ring
+/// into four staves: across u at ±√½ of the core's radius (the side staves, whose seams are across
+/// their lift), then across v at the middle (top and bottom, sliding along the side staves' seams as
+/// they are lifted). A lining that isMouthRingExtent (@p wallMm, @p thinGapMm) stays one ring, a
+/// mouth ring (CellSet::isMouthRing): behind it lies only the face's wall, no ball. A lining whose
+/// staves, cut square to the grid, would lie under a wall too thin for a ball (staveUnderThinWall
+/// with @p thinGapMm) more often than turned 45° about the axis is cut turned
+/// (CellSet::isStaveTurned): under a face, a tunnel's stave facing the face has no room for a ball
+/// behind it, one facing the diagonal between the face and the inside has. Sets each ring's depth
+/// (CellSet::ringDepthMm). Returns how many cuts; pieces the cuts left empty are the caller's to drop.
+size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field, double wallMm,
+                 double thinGapMm);
 
 /// How far a stave is held off its place while it slides (mm) before its tenons are known: its
 /// pegs' depth (4 mm) and as much again (setStaveLifts makes it longer).
@@ -99,9 +131,10 @@ inline constexpr double kStaveLiftMm = 8.0;
 /// Each stave's lift (the plan's steps of two legs) once its tenons are known: held that far off
 /// its place along its direction, every peg's tip lies at least 2 mm shallower under its wall than
 /// the frame may come (@p frameDMinMm), so its stems slide along the tunnel past no ball and no
-/// strut. Depth is taken across the wall (the grid axis across the slide nearest the direction),
-/// from the stave's voxel nearest the tunnel's axis (a voxel's half under the surface).
-void setStaveLifts(Pieces& out, const VoxelField& field, const Transform4d& frameToGridMm,
-                   double frameDMinMm);
+/// strut. Depth is taken across the wall (of the ways its ring's staves are lifted, staveLifts,
+/// the nearest the direction reversed), from the stave's voxel nearest the tunnel's axis (a voxel's
+/// half under the surface).
+void setStaveLifts(Pieces& out, const std::vector<CellSet>& sets, const VoxelField& field,
+                   const Transform4d& frameToGridMm, double frameDMinMm);
 
 }  // namespace zomefab::pieces::detail

@@ -78,6 +78,10 @@ struct CellSet {
     /// A staved prism's lining at a mouth too short to reach behind the face's wall (cutStaves):
     /// one ring, not cut into staves, that slides in along the tunnel and is glued on.
     bool isMouthRing = false;
+    /// A staved prism's lining whose rings are cut into staves turned 45° about the axis (their
+    /// lifts along the diagonals of the grid axes across it): fewer of them under a wall too thin
+    /// for a ball (cutStaves; a tunnel just under a face of the cheese).
+    bool isStaveTurned = false;
 };
 
 /// δ_P: a signed distance to the region of the piece's cells (negative inside), from the planes
