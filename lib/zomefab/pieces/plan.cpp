@@ -485,10 +485,12 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
     if (opt.isCuttingForSupport && opt.isGluingUnderHeld) splitForPrint(replanner, fabrication);
     const size_t unpinned = placePins(out, field, cells, grouping.cellSets, opt, GlueOnRule{}.minCosine);
     if (unpinned > 0)
-        context.warn(std::to_string(unpinned) + " of " +
-                     std::to_string(out.plan.glued.size() + out.plan.gluedOn.size()) +
-                     " glued pairs have fewer than " + std::to_string(opt.pins.perPair) +
-                     " alignment pins (the face has no room): line them up by eye when gluing");
+        context.warn(
+            std::to_string(unpinned) + " of " +
+            std::to_string(out.plan.glued.size() + out.plan.gluedOn.size()) +
+            " glued pairs have fewer than " + std::to_string(opt.pins.perPair) +
+            " alignment pins (the face has no room for them, or runs along the way the piece goes on, as a "
+            "stave glued in place slides along its seams): line them up by eye when gluing");
     TenonPlan plan = chooseTenons(candidates, out.plan.holeOfPiece, opt.tenons);
     for (size_t p = 0; p < out.pieces.size(); ++p) {
         out.pieces[p].hole = out.plan.holeOfPiece[p];

@@ -134,7 +134,8 @@ std::vector<std::string> mountingSentences(const MountingStep& step) {
     for (const GlueJoint& g : step.gluedOnto)
         lines.push_back("Put glue on the cut face of " + g.a + " that meets " + g.b +
                         " (already on): " + g.a + " is glued onto it as it goes on (" +
-                        (g.pins == 0 ? std::string("no room for alignment pins: line it up by eye")
+                        (g.pins == 0 ? std::string("no alignment pins (no room for them, or the face runs "
+                                                   "along the way it goes on): line it up by eye")
                                      : std::to_string(g.pins) + " alignment pin" + (g.pins == 1 ? "" : "s") +
                                            " on " + g.b + " go into its sockets") +
                         ").");
