@@ -398,13 +398,9 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
     int keystones = 0;
     // Three tunnels through one point: their linings are carved into staves before any plan, which
     // the partition's pieces there would leave stuck whatever it did (the cheese at 700 mm: 215 s).
-    bool isTriple = false;
-    crossingPrisms(field, 2.0 * fabrication.wallMm, fabrication.wallMm + 2.0 * field.voxelMm,
-                   fabrication.wallMm + field.voxelMm, &isTriple, false);
-    const bool isCarved =
-        isTriple && carveCrossingLinings(out.pieces, grouping, field, cells, fabrication.wallMm,
-                                         fabrication.frameDMinMm(), thinGapMm,
-                                         splitSearchFor(field, opt).minVolumeMm3, context) > 0;
+    const bool isCarved = carveCrossingLinings(out.pieces, grouping, field, cells, fabrication.wallMm,
+                                               fabrication.frameDMinMm(), thinGapMm,
+                                               splitSearchFor(field, opt).minVolumeMm3, context, true) > 0;
     for (int round = 0;; ++round) {
         const Stopwatch clock;
         candidates = freshCandidates(frame, frameToGridMm, probe, opt, lost);

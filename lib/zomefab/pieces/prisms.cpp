@@ -158,12 +158,11 @@ double TunnelPrism::splitMm() const {
     return best;
 }
 
-namespace {
-
-/// The centre of @p p's core along grid axis @p a (its own axis excluded).
-double centreAlong(const TunnelPrism& p, int a) { return a == (p.axis + 1) % 3 ? p.centerUMm : p.centerVMm; }
-
-}  // namespace
+Vec3d TunnelPrism::axisPointMm() const {
+    Vec3d c{0, 0, 0};
+    c[size_t(axis + 1) % 3] = centerUMm, c[size_t(axis + 2) % 3] = centerVMm;
+    return c;
+}
 
 void markCrossings(std::vector<TunnelPrism>& prisms) {
     for (TunnelPrism& p : prisms) {
@@ -171,9 +170,10 @@ void markCrossings(std::vector<TunnelPrism>& prisms) {
         for (const TunnelPrism& q : prisms) {
             if (q.axis == p.axis || !q.isStaved) continue;
             const int c = 3 - p.axis - q.axis;  // the third axis
-            const double t = centreAlong(q, p.axis), b = centreAlong(p, q.axis);
-            if (std::abs(centreAlong(p, c) - centreAlong(q, c)) <= p.coreRadiusMm && t >= p.loMm &&
-                t <= p.hiMm && b >= q.loMm && b <= q.hiMm)
+            const Vec3d pc = p.axisPointMm(), qc = q.axisPointMm();
+            const double t = qc[size_t(p.axis)], b = pc[size_t(q.axis)];
+            if (std::abs(pc[size_t(c)] - qc[size_t(c)]) <= p.coreRadiusMm && t >= p.loMm && t <= p.hiMm &&
+                b >= q.loMm && b <= q.hiMm)
                 list.push_back({t, q.coreRadiusMm});
         }
         std::sort(list.begin(), list.end());
@@ -401,7 +401,7 @@ size_t cutRings(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelFie
 
 size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
                             const GridCells& cells, double wallMm, double frameDMinMm, double thinGapMm,
-                            double minPieceVolumeMm3, const RunContext& context) {
+                            double minPieceVolumeMm3, const RunContext& context, bool isOnlyWhereThreeCross) {
     std::vector<CellSet>& sets = grouping.cellSets;
     // A wall and two voxels: the shell's voxels reach a voxel past the wall (φ < 0 at their
     // centres), and the core's columns lie up to a voxel off the surface.
@@ -410,7 +410,7 @@ size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, Voxe
     bool isTriple = false;
     const std::vector<TunnelPrism> found =
         crossingPrisms(field, 2.0 * wallMm, radiusMm, wallMm + field.voxelMm, &isTriple, true);
-    if (found.empty()) return 0;
+    if (found.empty() || (isOnlyWhereThreeCross && !isTriple)) return 0;
     std::vector<TunnelPrism> marked = found;
     if (isTriple) markCrossings(marked);
     std::vector<std::shared_ptr<const TunnelPrism>> prisms;

@@ -28,20 +28,13 @@ std::array<Vec3d, 4> staveLifts(int axis, bool isTurned) {
 
 namespace {
 
-/// A point on the axis of @p prism (grid mm).
-Vec3d axisPoint(const TunnelPrism& prism) {
-    Vec3d c{0, 0, 0};
-    c[size_t(prism.axis + 1) % 3] = prism.centerUMm, c[size_t(prism.axis + 2) % 3] = prism.centerVMm;
-    return c;
-}
-
 /// How many of the four staves of lining @p p (its slots @p slots, its prism @p prism), cut square
 /// to the grid or turned (@p isTurned), would lie under a wall too thin for a ball: each inside
 /// voxel counted with the stave whose lift it lies farthest along from the axis.
 size_t thinStaveCount(const VoxelField& field, const std::vector<size_t>& slots, uint32_t p,
                       const TunnelPrism& prism, bool isTurned, double thinGapMm) {
     const std::array<Vec3d, 4> lifts = staveLifts(prism.axis, isTurned);
-    const Vec3d c = axisPoint(prism);
+    const Vec3d c = prism.axisPointMm();
     std::array<std::vector<Vec3d>, 4> sectors;
     for (size_t s : slots) {
         if (!field.isInside(s)) continue;
@@ -134,7 +127,7 @@ size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelFi
         const double off = std::sqrt(0.5) * prism->coreRadiusMm;
         for (uint32_t r : rings) {
             const std::array<Vec3d, 4> lifts = staveLifts(a, sets[r].isStaveTurned);
-            const Vec3d su = lifts[0], sv = lifts[2], c = axisPoint(*prism);
+            const Vec3d su = lifts[0], sv = lifts[2], c = prism->axisPointMm();
             const double cu = dot(su, c), cv = dot(sv, c);
             split(r, su, cu + off);
             split(r, scale(su, -1.0), off - cu);
@@ -220,7 +213,7 @@ std::optional<Stave> staveOf(const CellSet& set, const std::vector<Vec3d>& voxel
     Vec3d mean{0, 0, 0};
     for (const Vec3d& x : voxelsMm) mean = add(mean, x);
     mean = scale(mean, 1.0 / double(voxelsMm.size()));
-    const Vec3d r = sub(mean, axisPoint(*prism));
+    const Vec3d r = sub(mean, prism->axisPointMm());
     const double du = dot(r, lifts[0]), dv = dot(r, lifts[2]);
     const double slide = mean[size_t(a)] >= prism->splitMm() ? 1.0 : -1.0;
     const bool isSide = std::abs(du) >= std::abs(dv);
@@ -244,7 +237,7 @@ void setStaveLifts(Pieces& out, const std::vector<CellSet>& sets, const VoxelFie
         const uint32_t p = step.pieces[0];
         const Vec3d in = gridDirection(step.hole, frameToGridMm);
         const TunnelPrism* prism = p < sets.size() ? ownPrism(sets[p]) : nullptr;
-        if (!prism) continue;  // a stave's step: not reached
+        if (!prism) continue;  // every step of two legs is a stave's, which has its prism
         stepOf[p] = int(s);
         const std::array<Vec3d, 4> lifts = staveLifts(prism->axis, sets[p].isStaveTurned);
         wallOut[p] = *std::max_element(lifts.begin(), lifts.end(), [&](const Vec3d& x, const Vec3d& y) {

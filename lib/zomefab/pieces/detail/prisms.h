@@ -53,6 +53,8 @@ struct TunnelPrism {
     /// crossings (where three tunnels cross the lining is broken anyway) the one nearest its middle,
     /// the lower on a tie; its middle when none is known.
     double splitMm() const;
+    /// The point of its core's middle line where the grid's axis coordinate is 0 (grid mm).
+    Vec3d axisPointMm() const;
 
     /// The core distance of column (u, v); a far value off the raster.
     double columnDistanceMm(int u, int v) const;
@@ -104,9 +106,11 @@ std::pair<double, double> extentAlong(const VoxelField& field, const std::vector
 /// prisms are staved: a later axis keeps the shell where they overlap, each lining is cut at its
 /// tunnel's middle, into rings, and each ring into four staves by planes along the axis at ±√½ of
 /// the core's radius across u and at the middle across v (Stave), or turned 45° about the axis
-/// where fewer staves then lie under a wall too thin for a ball (@p thinGapMm, cutStaves).
+/// where fewer staves then lie under a wall too thin for a ball (@p thinGapMm, cutStaves). With
+/// @p isOnlyWhereThreeCross nothing is carved unless three tunnels cross at one point.
 size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
                             const GridCells& cells, double wallMm, double frameDMinMm, double thinGapMm,
-                            double minPieceVolumeMm3, const RunContext& context);
+                            double minPieceVolumeMm3, const RunContext& context,
+                            bool isOnlyWhereThreeCross = false);
 
 }  // namespace zomefab::pieces::detail

@@ -111,9 +111,9 @@ public:
         /// as kPieces, for a piece cut into parts glued before mounting (splitForPrint): judged by
         /// the steps under-held (kGroups), which must not grow
         kParts,
-        /// as kFrame, for the frame grown toward staves: judged by the staves the plan places
-        /// nowhere, which must be fewer (the plan need not be one that can be carried out: more
-        /// rounds may follow)
+        /// as kFrame, for the frame grown toward staves: judged by the staves no peg holds (placed
+        /// nowhere or glued in place), which must be fewer; the plan need not be one that can be
+        /// carried out (more rounds may follow), but one that could must stay so
         kStaves,
     };
     /// Makes @p change, recomputes what it touched (for kPieces the faces and the tenon candidates,
