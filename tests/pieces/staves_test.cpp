@@ -92,7 +92,7 @@ TEST_CASE("cutStaves: a staved lining is cut at its tunnel's middle and each rin
     const size_t lining = z.lining;
     REQUIRE(lining > 1000);
     // Two halves of 32 mm, one ring each (under kStaveRingMm), four staves per ring: seven cuts.
-    CHECK(cutStaves(pieces, sets, three, 6.0, 0.0) == 7);  // 64 mm: longer than a mouth ring (18 mm)
+    CHECK(cutStaves(pieces, sets, three, 6.0, 0.0, 0.0) == 7);  // 64 mm: longer than a mouth ring (18 mm)
     REQUIRE(pieces.size() == 9);
     const double c = prisms[2].centerUMm, off = std::sqrt(0.5) * prisms[2].coreRadiusMm;
     std::vector<std::vector<Vec3d>> voxels(pieces.size());
@@ -121,11 +121,32 @@ TEST_CASE("cutStaves: a staved lining is cut at its tunnel's middle and each rin
     CHECK(tops == 4);
 }
 
+TEST_CASE("cutStaves: a cut that would leave less than the least volume on one side is not made") {
+    ZLining z;
+    const double voxelMm3 = z.three.voxelMm * z.three.voxelMm * z.three.voxelMm;
+    const double ringMm3 = 0.5 * double(z.lining) * voxelMm3;  // a half of 32 mm: one ring
+    // A side stave is about a quarter of its ring: with 35 % of a ring as the least, the seams across
+    // u are not cut, the one across v is (halves): per ring one cut, and the middle.
+    CHECK(cutStaves(z.pieces, z.sets, z.three, 6.0, 0.0, 0.35 * ringMm3) == 3);
+    REQUIRE(z.pieces.size() == 5);
+    std::vector<size_t> count(z.pieces.size(), 0);
+    for (size_t s = 0; s < z.three.owner.size(); ++s)
+        if (z.three.isInside(s)) ++count[z.three.owner[s]];
+    for (uint32_t p = 0; p < z.pieces.size(); ++p) {
+        if (p == 1) continue;  // the rest of the shell
+        CHECK(isStaveSet(z.sets[p]));
+        CHECK(double(count[p]) * voxelMm3 >= 0.35 * ringMm3);
+    }
+    // With no least volume, the same lining is cut into eight staves.
+    ZLining all;
+    CHECK(cutStaves(all.pieces, all.sets, all.three, 6.0, 0.0, 0.0) == 7);
+}
+
 TEST_CASE("cutStaves: a lining at a mouth no longer than a mouth ring stays one ring") {
     ZLining z;
     std::vector<CellSet>& sets = z.sets;
     // The z lining runs from mouth to mouth, 63 mm between its voxels' centres: under three walls of 24 mm.
-    CHECK(cutStaves(z.pieces, sets, z.three, 24.0, 0.0) == 0);
+    CHECK(cutStaves(z.pieces, sets, z.three, 24.0, 0.0, 0.0) == 0);
     REQUIRE(z.pieces.size() == 2);
     CHECK(sets[0].isMouthRing);
     CHECK(sets[0].ringDepthMm == doctest::Approx(63.0).epsilon(0.05));
@@ -139,7 +160,7 @@ TEST_CASE("staveUnderThinWall: a stave whose face lies a little hollow away") {
     // A hollow cube with walls of 4 mm: between the z tunnel's lining (radius 10 to 14 mm round the
     // middle, 31.5 mm) and the faces' walls (from 60 mm) lies a hollow about 14 mm across.
     ZLining z(4.0);
-    REQUIRE(cutStaves(z.pieces, z.sets, z.three, 6.0, 0.0) == 7);  // no gap: cut square to the grid
+    REQUIRE(cutStaves(z.pieces, z.sets, z.three, 6.0, 0.0, 0.0) == 7);  // no gap: cut square to the grid
     std::vector<std::vector<Vec3d>> voxels(z.pieces.size());
     for (size_t s = 0; s < z.three.owner.size(); ++s)
         if (z.three.isInside(s)) voxels[z.three.owner[s]].push_back(z.three.world(z.three.coordOf(s)));
@@ -178,7 +199,7 @@ TEST_CASE("cutStaves: a lining under a face's thin wall is cut into staves turne
     // The hollow cube of 4 mm walls: square to the grid each stave faces a face's wall 14 to 18 mm of
     // hollow away, along a diagonal 19 to 24 mm; a ball needing 18 mm fits only there.
     ZLining z(4.0);
-    REQUIRE(cutStaves(z.pieces, z.sets, z.three, 6.0, 18.0) == 7);
+    REQUIRE(cutStaves(z.pieces, z.sets, z.three, 6.0, 18.0, 0.0) == 7);
     std::vector<std::vector<Vec3d>> voxels(z.pieces.size());
     for (size_t s = 0; s < z.three.owner.size(); ++s)
         if (z.three.isInside(s)) voxels[z.three.owner[s]].push_back(z.three.world(z.three.coordOf(s)));

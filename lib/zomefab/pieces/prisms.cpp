@@ -430,7 +430,7 @@ size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, Voxe
     ownBand(field, prismOf, isLining);
     const size_t joined = joinRemnants(pieces, sets, field, cells, minPieceVolumeMm3);
     if (isTriple) {
-        cutStaves(pieces, sets, field, wallMm, thinGapMm);
+        cutStaves(pieces, sets, field, wallMm, thinGapMm, minPieceVolumeMm3);
         dropEmptyPieces(pieces, sets, field);
         grouping.faces = faceContacts(field, cells, sets, pieces);
         const size_t staves = size_t(std::count_if(sets.begin(), sets.end(), isStaveSet));

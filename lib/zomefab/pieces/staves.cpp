@@ -68,10 +68,24 @@ bool isMouthRingExtent(const TunnelPrism& prism, double loMm, double hiMm, doubl
 }
 
 size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field, double wallMm,
-                 double thinGapMm) {
+                 double thinGapMm, double minVolumeMm3) {
     std::vector<std::vector<size_t>> slots = slotsOfPieces(field, pieces.size());
     size_t cuts = 0;
-    auto split = [&](uint32_t p, const Vec3d& normal, double offsetMm) {
+    const double voxelMm3 = field.voxelMm * field.voxelMm * field.voxelMm;
+    // Where a cut would leave less than minVolumeMm3 on one side (a corner bit a crossing leaves of
+    // a lining, cut off by a ring's seam: a sliver no peg reaches), that side stays with the rest.
+    auto isWorthCutting = [&](uint32_t p, const Vec3d& normal, double offsetMm) {
+        size_t above = 0, inside = 0;
+        for (size_t s : slots[p]) {
+            if (!field.isInside(s)) continue;
+            ++inside;
+            above += dot(normal, field.world(field.coordOf(s))) > offsetMm ? 1 : 0;
+        }
+        return double(std::min(above, inside - above)) * voxelMm3 >= minVolumeMm3;
+    };
+    // Returns the new piece, or p where the cut is not made. Equal rings of a segment are never slivers.
+    auto split = [&](uint32_t p, const Vec3d& normal, double offsetMm, bool isEqualPart = false) {
+        if (!isEqualPart && !isWorthCutting(p, normal, offsetMm)) return p;
         slots.emplace_back();
         std::vector<size_t> newSlots;
         const uint32_t q = splitPiece(pieces, sets, field, p, {normal, offsetMm}, &slots[p], &newSlots);
@@ -98,7 +112,8 @@ size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelFi
         std::vector<uint32_t> segments{p};
         for (double t : planes)
             if (const auto [lo, hi] = extentAlong(field, slots[segments.back()], a); lo < t && hi > t)
-                segments.push_back(split(segments.back(), axis, t));
+                if (const uint32_t q = split(segments.back(), axis, t); q != segments.back())
+                    segments.push_back(q);
         std::vector<uint32_t> rings;
         for (uint32_t g : segments) {
             const auto [lo, hi] = extentAlong(field, slots[g], a);
@@ -114,7 +129,7 @@ size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelFi
             const int count = int(std::ceil((hi - lo) / kStaveRingMm));
             std::vector<uint32_t> along{g};
             for (int k = 1; k < count; ++k)
-                along.push_back(split(along.back(), axis, lo + (hi - lo) * k / count));
+                along.push_back(split(along.back(), axis, lo + (hi - lo) * k / count, true));
             for (size_t k = 0; k < along.size(); ++k) {
                 // along[k] holds [lo + k·len, lo + (k+1)·len]: its far end from its mouth.
                 const double len = (hi - lo) / double(along.size());

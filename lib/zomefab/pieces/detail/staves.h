@@ -120,9 +120,11 @@ bool isMouthRingExtent(const TunnelPrism& prism, double loMm, double hiMm, doubl
 /// with @p thinGapMm) more often than turned 45° about the axis is cut turned
 /// (CellSet::isStaveTurned): under a face, a tunnel's stave facing the face has no room for a ball
 /// behind it, one facing the diagonal between the face and the inside has. Sets each ring's depth
-/// (CellSet::ringDepthMm). Returns how many cuts; pieces the cuts left empty are the caller's to drop.
+/// (CellSet::ringDepthMm). A cut at a crossing or a seam that would leave less than @p minVolumeMm3
+/// on one side is not made: that side stays with the rest. Returns how many cuts; pieces the cuts
+/// left empty are the caller's to drop.
 size_t cutStaves(std::vector<Piece>& pieces, std::vector<CellSet>& sets, VoxelField& field, double wallMm,
-                 double thinGapMm);
+                 double thinGapMm, double minVolumeMm3);
 
 /// How far a stave is held off its place while it slides (mm) before its tenons are known: its
 /// pegs' depth (4 mm) and as much again (setStaveLifts makes it longer).
