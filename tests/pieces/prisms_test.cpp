@@ -7,6 +7,7 @@
 
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -90,16 +91,30 @@ TEST_CASE(
         CHECK(p.centerVMm == doctest::Approx(31.5).epsilon(0.02));
         CHECK(p.coreRadiusMm == doctest::Approx(10.0).epsilon(0.15));
     }
-    const std::vector<uint32_t> owner = prismOwners(three, prisms, true);
-    size_t shared = 0;
-    for (size_t s = 0; s < owner.size(); ++s) {
-        if (!three.isInside(s)) continue;
-        const Coord ijk = three.coordOf(s);
-        uint32_t expected = kNone;
-        for (uint32_t k = 0; k < 3; ++k)
-            if (prisms[k].contains(ijk)) expected = k;  // the latest axis holding it
-        shared += prisms[0].contains(ijk) && prisms[2].contains(ijk);
-        if (owner[s] != expected) FAIL_CHECK("voxel owned by " << owner[s] << ", expected " << expected);
-    }
-    CHECK(shared > 100);
+    // Each inside voxel owned by the prism of the highest priority holding it (@p order: lowest
+    // first); returns how many of them the x prism holds with the z prism and @p keeper owns.
+    auto checkOwners = [&](const std::vector<TunnelPrism>& list, const std::array<uint32_t, 3>& order,
+                           uint32_t keeper) {
+        const std::vector<uint32_t> owner = prismOwners(three, list, true);
+        size_t shared = 0;
+        for (size_t s = 0; s < owner.size(); ++s) {
+            if (!three.isInside(s)) continue;
+            const Coord ijk = three.coordOf(s);
+            uint32_t expected = kNone;
+            for (uint32_t k : order)
+                if (list[k].contains(ijk)) expected = k;
+            shared += owner[s] == keeper && list[0].contains(ijk) && list[2].contains(ijk);
+            if (owner[s] != expected) FAIL_CHECK("voxel owned by " << owner[s] << ", expected " << expected);
+        }
+        return shared;
+    };
+    CHECK(checkOwners(prisms, {0, 1, 2}, 2) > 100);  // the latest axis keeps the ridges
+    // The x tunnel made late (a second attempt): it keeps every overlap, the others as before.
+    std::vector<TunnelPrism> late = prisms;
+    const TunnelKey x{0, prisms[0].centerUMm + 0.5, prisms[0].centerVMm - 0.5};
+    CHECK(isTunnelOf(x, late[0], 1.0));
+    CHECK_FALSE(isTunnelOf(x, late[0], 0.25));
+    CHECK_FALSE(isTunnelOf({1, x.centerUMm, x.centerVMm}, late[0], 1.0));
+    late[0].priority = late[0].axis + kLatePriority;
+    CHECK(checkOwners(late, {1, 2, 0}, 0) > 100);
 }

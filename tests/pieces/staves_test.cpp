@@ -55,6 +55,16 @@ TEST_CASE(
     CHECK(isStaveDirection(*sd, {-s, c, 0}));       // toward its mouth (−x here)
     CHECK_FALSE(isStaveDirection(*sd, {0, c, s}));  // round the axis: its edges past the corners
     CHECK_FALSE(isStaveDirection(*sd, {s, c, 0}));  // toward the deeper staves (+x here)
+    // First in the order by its axis; a late tunnel's stave after every axis's (TunnelPrism::priority).
+    CHECK(std::get<0>(st->rank) == 0);
+    TunnelPrism late = prisms[0];
+    late.priority = late.axis + kLatePriority;
+    CellSet lateSet = set;
+    lateSet.prisms[0].prism = std::make_shared<const TunnelPrism>(late);
+    const std::optional<Stave> lateStave = staveOf(lateSet, top);
+    REQUIRE(lateStave.has_value());
+    CHECK(std::get<0>(lateStave->rank) == kLatePriority);
+    CHECK(lateStave->rank > st->rank);
     // A piece of no staved prism is no stave.
     CellSet plain;
     CHECK_FALSE(staveOf(plain, top).has_value());
@@ -137,6 +147,14 @@ TEST_CASE("cutStaves: a cut that would leave less than the least volume on one s
         CHECK(isStaveSet(z.sets[p]));
         CHECK(double(count[p]) * voxelMm3 >= 0.35 * ringMm3);
     }
+    // The tunnel of the staves a plan places nowhere, once: made late in another attempt.
+    std::vector<int> holes(z.pieces.size(), -1);
+    const std::vector<TunnelKey> unheld = unheldTunnels(holes, z.sets);
+    REQUIRE(unheld.size() == 1);
+    CHECK(unheld[0].axis == 2);
+    CHECK(isTunnelOf(unheld[0], z.prisms[2], 0.01));
+    for (int& h : holes) h = 0;
+    CHECK(unheldTunnels(holes, z.sets).empty());
     // With no least volume, the same lining is cut into eight staves.
     ZLining all;
     CHECK(cutStaves(all.pieces, all.sets, all.three, 6.0, 0.0, 0.0) == 7);

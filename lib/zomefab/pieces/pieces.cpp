@@ -21,6 +21,7 @@
 #include "zomefab/pieces/detail/grouping.h"
 #include "zomefab/pieces/detail/splits.h"
 #include "zomefab/pieces/detail/stages.h"
+#include "zomefab/pieces/detail/staves.h"
 #include "zomefab/pieces/detail/thin_wall.h"
 #include "zomefab/sdf/level_set_grid.h"
 
@@ -181,6 +182,87 @@ void planTenonsToFit(Pieces& out, VoxelField& field, const GridCells& cells, Gro
     }
 }
 
+/// What one attempt at the plan leaves for the meshing: the voxels, the pieces' grouping and the
+/// frame as the pieces stage grew it.
+struct Attempt {
+    VoxelField field;
+    Grouping grouping;
+    zome::Structure frame;
+    size_t unplacedStaves = 0;  ///< staves its plan places nowhere
+};
+
+/// How many times the tunnels of staves placed nowhere are made later and the pieces planned again
+/// (the cheese at 700 mm: 29 staves placed nowhere, then 16, then 9; a fourth time 9 again).
+constexpr int kLateLevels = 2;
+
+/// Adds tunnel @p key to @p late at @p level, or raises it there when it is in already.
+void raiseTunnel(std::vector<TunnelKey>& late, const TunnelKey& key, int level) {
+    for (TunnelKey& k : late)
+        if (k.axis == key.axis && std::abs(k.centerUMm - key.centerUMm) < 1.0 &&
+            std::abs(k.centerVMm - key.centerVMm) < 1.0) {
+            k.level = level;
+            return;
+        }
+    late.push_back(key);
+    late.back().level = level;
+}
+
+/// Steps 1–3 (docs/pieces.md): the shell's voxels, the pieces of the partition's cells (@p cells),
+/// cut to fit the printer, and their plan, into @p out; the staves of @p lateTunnels go on last.
+Attempt planAttempt(Pieces& out, const FloatGrid& shell, const sdf::LevelSet& shellSet,
+                    const zome::Structure& frame, const Transform4d& frameToGridMm,
+                    const partition::PartitionResult& partition, const GridCells& cells,
+                    const Fabrication& fabrication, const PiecesOptions& options,
+                    const std::vector<TunnelKey>& lateTunnels, RunContext& context,
+                    const StrutTest& canGrow) {
+    const double voxel = out.voxelMm;
+    Attempt a;
+    VoxelField& field = a.field;
+    field = buildField(shell);
+    out.options.printWallMm =
+        resolvePrintWallMm(options.printWallMm, fabrication.wallMm, field.background, voxel);
+    if (out.options.printWallMm > 0)
+        field.thinPhi = thinWallPhi(field, out.options.printWallMm);
+    else if (options.printWallMm == kPrintWallAuto && fabrication.wallMm > 2 * kDefaultPrintWallMm)
+        context.info("pieces printed with the shell's " + formatNumber(fabrication.wallMm) +
+                     " mm wall: a printed wall of " + formatNumber(kDefaultPrintWallMm) +
+                     " mm needs a shell of at least " + formatNumber(2 * field.background + voxel) +
+                     " mm and voxels of at least " +
+                     formatNumber(kDefaultPrintWallMm / (field.background / voxel - 0.5), 3) + " mm");
+    context.throwIfCancelled();
+    labelCells(field, cells);
+    context.throwIfCancelled();
+    // A cell's components shared by several of the partition's pieces go by their surface boxes,
+    // grown by the wall's thickness.
+    const double growMm = std::max(shellSet.info().shellMm, 4 * voxel) + 2 * voxel;
+    Grouping& grouping = a.grouping;
+    grouping = groupPieces(field, cells, partition.pieces, affineInverse(frameToGridMm), growMm,
+                           out.options.minPieceVolumeMm3, context);
+    grouping.lateTunnels = lateTunnels;
+    // What the partition's cells could not make small enough (a cell meeting the surface in one
+    // large connected patch) is cut by planes here.
+    const size_t fitCuts =
+        splitTooLarge(grouping.pieces, grouping, field, cells, partition.pieces,
+                      partition.printerMm == fabrication.printerMm, fabrication.pieceBoxMm(),
+                      fabrication.fitMarginMm, out.options.minPieceVolumeMm3, context);
+    if (fitCuts > 0)
+        context.info(std::to_string(fitCuts) +
+                     " cut(s) by planes made the pieces the partition left larger than the printer fit it");
+    out.pieces = std::move(grouping.pieces);
+    out.shellVolumeMm3 = grouping.shellVolumeMm3;
+    out.outsideCellsVolumeMm3 = grouping.outsideCellsVolumeMm3;
+    out.sliversMerged = grouping.sliversMerged;
+    out.isolatedSlivers = grouping.isolatedSlivers;
+    context.progress("pieces", 0.25);
+    context.throwIfCancelled();
+    // The frame as the pieces stage may grow it (PiecesOptions::isGrowingFrame).
+    a.frame = frame;
+    planTenonsToFit(out, field, cells, grouping, shell, a.frame, frameToGridMm, fabrication, canGrow,
+                    context);
+    a.unplacedStaves = unplacedStaves(out.plan.holeOfPiece, grouping.cellSets);
+    return a;
+}
+
 }  // namespace
 
 void checkPiecesOptions(const PiecesOptions& o) {
@@ -228,48 +310,35 @@ Pieces makePieces(const sdf::LevelSet& shellSet, const zome::Structure& frame,
     out.gridTransformMm = shellSet.info().transformMm;
 
     context.progress("pieces", 0.0);
-    VoxelField field = buildField(*shell);
-    out.options.printWallMm =
-        resolvePrintWallMm(options.printWallMm, fabrication.wallMm, field.background, voxel);
-    if (out.options.printWallMm > 0)
-        field.thinPhi = thinWallPhi(field, out.options.printWallMm);
-    else if (options.printWallMm == kPrintWallAuto && fabrication.wallMm > 2 * kDefaultPrintWallMm)
-        context.info("pieces printed with the shell's " + formatNumber(fabrication.wallMm) +
-                     " mm wall: a printed wall of " + formatNumber(kDefaultPrintWallMm) +
-                     " mm needs a shell of at least " + formatNumber(2 * field.background + voxel) +
-                     " mm and voxels of at least " +
-                     formatNumber(kDefaultPrintWallMm / (field.background / voxel - 0.5), 3) + " mm");
-    context.throwIfCancelled();
     const GridCells cells = toGridCells(partition.cells, frameToGridMm);
-    labelCells(field, cells);
-    context.throwIfCancelled();
-    // A cell's components shared by several of the partition's pieces go by their surface boxes,
-    // grown by the wall's thickness.
-    const double growMm = std::max(shellSet.info().shellMm, 4 * voxel) + 2 * voxel;
-    Grouping grouping = groupPieces(field, cells, partition.pieces, affineInverse(frameToGridMm), growMm,
-                                    out.options.minPieceVolumeMm3, context);
-    // What the partition's cells could not make small enough (a cell meeting the surface in one
-    // large connected patch) is cut by planes here.
-    const size_t fitCuts =
-        splitTooLarge(grouping.pieces, grouping, field, cells, partition.pieces,
-                      partition.printerMm == fabrication.printerMm, fabrication.pieceBoxMm(),
-                      fabrication.fitMarginMm, out.options.minPieceVolumeMm3, context);
-    if (fitCuts > 0)
-        context.info(std::to_string(fitCuts) +
-                     " cut(s) by planes made the pieces the partition left larger than the printer fit it");
-    out.pieces = std::move(grouping.pieces);
-    out.shellVolumeMm3 = grouping.shellVolumeMm3;
-    out.outsideCellsVolumeMm3 = grouping.outsideCellsVolumeMm3;
-    out.sliversMerged = grouping.sliversMerged;
-    out.isolatedSlivers = grouping.isolatedSlivers;
-    context.progress("pieces", 0.25);
-    context.throwIfCancelled();
-
-    // The frame as the pieces stage may grow it (PiecesOptions::isGrowingFrame).
-    zome::Structure frameNow = frame;
-    planTenonsToFit(out, field, cells, grouping, *shell, frameNow, frameToGridMm, fabrication, canGrow,
-                    context);
-    if (out.frameStrutsGrown > 0) out.grownFrame = std::move(frameNow);
+    const Pieces header = out;
+    Attempt attempt = planAttempt(out, *shell, shellSet, frame, frameToGridMm, partition, cells, fabrication,
+                                  options, {}, context, canGrow);
+    // Staves placed nowhere lie in rings of the first tunnels to go on (the cheese at 700 mm: x
+    // tunnels under its faces), which no peg reaches and which cannot glue onto the crossing
+    // tunnels' staves, on later. Again with those tunnels last: their staves keep the overlaps and
+    // may be glued in place onto the crossing staves pegs hold; while fewer are placed nowhere, the
+    // tunnels left so then later still.
+    std::vector<TunnelKey> late;
+    size_t unplaced = attempt.unplacedStaves;
+    for (int level = 1; level <= kLateLevels && unplaced > 0 && out.options.tenons.maxPerPiece > 0 &&
+                        !attempt.grouping.unheldTunnels.empty();
+         ++level) {
+        for (const TunnelKey& key : attempt.grouping.unheldTunnels) raiseTunnel(late, key, level);
+        context.info(std::to_string(unplaced) + " staves of " +
+                     std::to_string(attempt.grouping.unheldTunnels.size()) +
+                     " tunnel(s) placed nowhere: planning again with their staves put on later, glued in "
+                     "place onto the crossing tunnels' where no peg holds them");
+        attempt = Attempt{};  // the last attempt's voxels go before the next one's are made
+        out = header;
+        attempt = planAttempt(out, *shell, shellSet, frame, frameToGridMm, partition, cells, fabrication,
+                              options, late, context, canGrow);
+        if (attempt.unplacedStaves >= unplaced) break;  // no better: refused as it is
+        unplaced = attempt.unplacedStaves;
+    }
+    VoxelField& field = attempt.field;
+    Grouping& grouping = attempt.grouping;
+    if (out.frameStrutsGrown > 0) out.grownFrame = std::move(attempt.frame);
     // An object that cannot be built is said before the meshing, the stage's longest step.
     if (out.options.tenons.maxPerPiece > 0) requireBuildable(out);
     context.progress("pieces", 0.35);

@@ -533,6 +533,7 @@ void planPieces(Pieces& out, VoxelField& field, const GridCells& cells, Grouping
             ballGapMm(frame.scale().ballRadiusMm(), fabrication.frameDMinMm(), fabrication.wallMm);
         if (noteUnheldStaves(out, grouping.cellSets, field, thinGapMm) == 0)
             noteCrossingTunnels(out, field, fabrication.wallMm);
+        grouping.unheldTunnels = unheldTunnels(out.plan.holeOfPiece, grouping.cellSets);
         return;
     }
     // The printed wall, where thinner than the plan's (thin_wall.h): after the plan, before numbers.

@@ -206,6 +206,7 @@ TunnelPrism tunnelPrism(const TunnelCore& core, const VoxelField& field, double 
                         double hiMm) {
     TunnelPrism p;
     p.axis = core.axis;
+    p.priority = core.axis;
     p.radiusMm = radiusMm, p.loMm = loMm, p.hiMm = hiMm;
     p.voxelMm = field.voxelMm, p.originMm = field.originMm;
     int minU = std::numeric_limits<int>::max(), minV = minU, maxU = std::numeric_limits<int>::min(),
@@ -244,6 +245,11 @@ TunnelPrism tunnelPrism(const TunnelCore& core, const VoxelField& field, double 
     return p;
 }
 
+bool isTunnelOf(const TunnelKey& key, const TunnelPrism& prism, double toleranceMm) {
+    return key.axis == prism.axis && std::abs(key.centerUMm - prism.centerUMm) <= toleranceMm &&
+           std::abs(key.centerVMm - prism.centerVMm) <= toleranceMm;
+}
+
 std::vector<uint32_t> prismOwners(const VoxelField& field, const std::vector<TunnelPrism>& prisms,
                                   bool isLaterFirst) {
     std::vector<uint32_t> out(field.owner.size(), kNone);
@@ -252,13 +258,12 @@ std::vector<uint32_t> prismOwners(const VoxelField& field, const std::vector<Tun
     for (size_t s = 0; s < out.size(); ++s) {
         if (!field.isActive[s]) continue;
         const Coord ijk = field.coordOf(s);
-        for (int i = 0; i < 3; ++i) {
-            const int a = isLaterFirst ? 2 - i : i;
+        for (int a = 0; a < 3; ++a) {  // one prism per axis at most: parallel prisms do not overlap
             const uint32_t k = lookup.at(a, ijk);
-            if (k != kNone && prisms[k].contains(ijk)) {
-                out[s] = k;
-                break;
-            }
+            if (k == kNone || !prisms[k].contains(ijk)) continue;
+            if (out[s] == kNone) out[s] = k;
+            if (!isLaterFirst) break;
+            if (prisms[k].priority > prisms[out[s]].priority) out[s] = k;
         }
     }
     return out;
@@ -349,7 +354,7 @@ std::vector<uint32_t> carveParts(std::vector<Piece>& pieces, std::vector<CellSet
         const uint32_t own = prismOf[s];
         set.prisms.push_back({prisms[own], true});
         for (const auto& prism : prisms)
-            if (isLaterFirst ? prism->axis > prisms[own]->axis : prism->axis < prisms[own]->axis)
+            if (isLaterFirst ? prism->priority > prisms[own]->priority : prism->axis < prisms[own]->axis)
                 set.prisms.push_back({prism, false});
         pieces.push_back(std::move(piece));
         sets.push_back(std::move(set));
@@ -408,9 +413,13 @@ size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, Voxe
     const double radiusMm = wallMm + 2.0 * field.voxelMm;
     if (!(wallMm < frameDMinMm)) return 0;  // the frame might reach into a prism
     bool isTriple = false;
-    const std::vector<TunnelPrism> found =
+    std::vector<TunnelPrism> found =
         crossingPrisms(field, 2.0 * wallMm, radiusMm, wallMm + field.voxelMm, &isTriple, true);
     if (found.empty() || (isOnlyWhereThreeCross && !isTriple)) return 0;
+    for (TunnelPrism& p : found)
+        for (const TunnelKey& key : grouping.lateTunnels)
+            if (isTriple && isTunnelOf(key, p, 2.0 * field.voxelMm))
+                p.priority = p.axis + kLatePriority * key.level;
     std::vector<TunnelPrism> marked = found;
     if (isTriple) markCrossings(marked);
     std::vector<std::shared_ptr<const TunnelPrism>> prisms;

@@ -238,7 +238,8 @@ std::optional<Stave> staveOf(const CellSet& set, const std::vector<Vec3d>& voxel
     st.liftGrid = scale(lifts[isSide ? 0 : 2], lift);
     st.seamGrid = lifts[0];
     st.isSide = isSide;
-    st.rank = {a, prism->centerUMm, prism->centerVMm, slide, -set.ringDepthMm, isSide ? 0 : 1, lift};
+    st.rank = {
+        prism->priority, prism->centerUMm, prism->centerVMm, slide, -set.ringDepthMm, isSide ? 0 : 1, lift};
     return st;
 }
 
@@ -392,6 +393,19 @@ size_t unplacedStaves(const std::vector<int>& holeOfPiece, const std::vector<Cel
     for (size_t p = 0; p < sets.size() && p < holeOfPiece.size(); ++p)
         unheld += holeOfPiece[p] < 0 && isStaveSet(sets[p]) ? 1 : 0;
     return unheld;
+}
+
+std::vector<TunnelKey> unheldTunnels(const std::vector<int>& holeOfPiece, const std::vector<CellSet>& sets) {
+    std::vector<TunnelKey> out;
+    for (size_t p = 0; p < sets.size() && p < holeOfPiece.size(); ++p) {
+        if (holeOfPiece[p] >= 0 || !isStaveSet(sets[p])) continue;
+        const TunnelPrism* prism = ownPrism(sets[p]);
+        const bool isListed = std::any_of(out.begin(), out.end(), [&](const TunnelKey& k) {
+            return isTunnelOf(k, *prism, 0.5 * prism->voxelMm);
+        });
+        if (!isListed) out.push_back({prism->axis, prism->centerUMm, prism->centerVMm});
+    }
+    return out;
 }
 
 bool isGluedOn(const mount::InstallationPlan& plan, uint32_t p) {

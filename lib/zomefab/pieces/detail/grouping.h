@@ -56,6 +56,14 @@ using FaceContacts = std::map<std::pair<uint32_t, uint32_t>, std::vector<CutCont
 FaceContacts faceContacts(const VoxelField& field, const GridCells& cells, const std::vector<CellSet>& sets,
                           std::vector<Piece>& pieces);
 
+/// A staved tunnel by its axis and its core's middle across it (grid mm, TunnelPrism): the same
+/// in another attempt at the same shell.
+struct TunnelKey {
+    int axis = 0;
+    double centerUMm = 0.0, centerVMm = 0.0;
+    int level = 1;  ///< how late (TunnelPrism::priority): the attempt after which it was made so
+};
+
 /// What the grouping made: the pieces (ids, cells, requests, neighbours, slivers, shell volume),
 /// their cell sets, the cut faces between them, and the merge counts.
 struct Grouping {
@@ -66,6 +74,11 @@ struct Grouping {
     double outsideCellsVolumeMm3 = 0.0;
     size_t sliversMerged = 0;
     size_t isolatedSlivers = 0;
+    /// Staved tunnels whose prisms keep every overlap and whose staves go on last (TunnelPrism::
+    /// priority): in a later attempt, those with a ring none of whose staves a peg held before.
+    std::vector<TunnelKey> lateTunnels;
+    /// After a plan that cannot be carried out: the tunnels of the staves it placed nowhere.
+    std::vector<TunnelKey> unheldTunnels;
 };
 
 /// The whole grouping (docs/pieces.md §1, steps 2–4): components, groups, merges of orphans and

@@ -43,6 +43,11 @@ struct TunnelPrism {
     /// Its lining is cut into staves (three tunnels cross at one point): a later axis keeps the
     /// shell where prisms overlap.
     bool isStaved = false;
+    /// Where staved prisms overlap, the one of the highest priority keeps the shell, and its staves
+    /// go on after the others' (Stave::rank): its axis (x 0, y 1, z 2), plus kLatePriority times
+    /// its level for a tunnel made late (TunnelKey; its rings' staves glue onto the crossing
+    /// tunnels' staves).
+    int priority = 0;
     double centerUMm = 0.0, centerVMm = 0.0;  ///< the core's middle across the axis (grid mm)
     double coreRadiusMm = 0.0;                ///< half the core's extent across the axis
     /// Where the staved prisms of other axes cross it (grid mm along its axis, in order), each with
@@ -65,13 +70,19 @@ struct TunnelPrism {
     double signedDistanceMm(const Vec3d& x) const;
 };
 
+/// Added to a late tunnel's priority per level (TunnelPrism::priority): above every axis.
+inline constexpr int kLatePriority = 3;
+
+/// Whether @p prism is @p key's tunnel: its axis, its core's middle within @p toleranceMm.
+bool isTunnelOf(const TunnelKey& key, const TunnelPrism& prism, double toleranceMm);
+
 /// The prism of @p core (the columns of @p field's grid within @p radiusMm of its columns'
 /// centres), ends at @p loMm and @p hiMm along its axis.
 TunnelPrism tunnelPrism(const TunnelCore& core, const VoxelField& field, double radiusMm, double loMm,
                         double hiMm);
 
 /// Which prism each slot of @p field lies in: of the prisms holding it, the one of the earliest axis
-/// (the latest with @p isLaterFirst; then the lowest index); kNone for none. Per slot, band included.
+/// (with @p isLaterFirst the highest TunnelPrism::priority); kNone for none. Per slot, band included.
 std::vector<uint32_t> prismOwners(const VoxelField& field, const std::vector<TunnelPrism>& prisms,
                                   bool isLaterFirst = false);
 
@@ -107,7 +118,8 @@ std::pair<double, double> extentAlong(const VoxelField& field, const std::vector
 /// tunnel's middle, into rings, and each ring into four staves by planes along the axis at ±√½ of
 /// the core's radius across u and at the middle across v (Stave), or turned 45° about the axis
 /// where fewer staves then lie under a wall too thin for a ball (@p thinGapMm, cutStaves). With
-/// @p isOnlyWhereThreeCross nothing is carved unless three tunnels cross at one point.
+/// @p isOnlyWhereThreeCross nothing is carved unless three tunnels cross at one point. The staved
+/// prisms of @p lateTunnels keep every overlap and their staves go on last (TunnelPrism::priority).
 size_t carveCrossingLinings(std::vector<Piece>& pieces, Grouping& grouping, VoxelField& field,
                             const GridCells& cells, double wallMm, double frameDMinMm, double thinGapMm,
                             double minPieceVolumeMm3, const RunContext& context,

@@ -23,17 +23,18 @@ namespace zomefab::pieces::detail {
 /// A stave: a piece of the lining of a tunnel that crosses two others at one point. Its place is
 /// reached only along its tunnel, out of the nearer mouth, held off its wall toward the axis, and it
 /// is then pushed onto pegs of balls behind the wall (docs/mounting.md, "Three tunnels through one
-/// point"). Staves go on before every other piece: x tunnels' first, then y's, then z's (each later
-/// axis keeps the shell where prisms overlap, so a stave's way meets only staves of its own
-/// tunnel), along a tunnel the deepest first, in a ring the side staves (across u) first.
+/// point"). Staves go on before every other piece: x tunnels' first, then y's, then z's, then the
+/// late tunnels' (TunnelPrism::priority: each later one keeps the shell where prisms overlap, so a
+/// stave's way meets only staves of its own tunnel), along a tunnel the deepest first, in a ring the
+/// side staves (across u) first.
 struct Stave {
     Vec3d slideGrid{0, 0, 0};  ///< unit, along the axis: the way it slides off, out of its mouth
     Vec3d liftGrid{0, 0, 0};   ///< unit, across the axis and out of it: the way it is pushed on
     Vec3d seamGrid{0, 0,
                    0};    ///< unit, across the axis: the normal of the seams between side staves and the rest
     bool isSide = false;  ///< a side stave (beyond the seams across seamGrid), else top or bottom
-    /// The mounting order, lowest first: axis, tunnel (its core's middle), mouth, −depth from the
-    /// mouth, side (0) or top and bottom (1), then the lift's sign.
+    /// The mounting order, lowest first: priority (TunnelPrism::priority), tunnel (its core's middle), mouth,
+    /// −depth from the mouth, side (0) or top and bottom (1), then the lift's sign.
     std::tuple<int, double, double, double, double, int, double> rank;
 };
 
@@ -75,6 +76,10 @@ bool staveUnderThinWall(const Stave& stave, uint32_t p, const std::vector<Vec3d>
 
 /// How many staves (@p sets) a plan places nowhere (@p holeOfPiece −1).
 size_t unplacedStaves(const std::vector<int>& holeOfPiece, const std::vector<CellSet>& sets);
+
+/// The tunnels (each once) of the staves a plan places nowhere (@p holeOfPiece −1): made late in
+/// another attempt (Grouping::lateTunnels), their staves may glue onto the crossing tunnels'.
+std::vector<TunnelKey> unheldTunnels(const std::vector<int>& holeOfPiece, const std::vector<CellSet>& sets);
 
 /// Whether @p plan glues piece @p p on (a stave glued in place: no peg holds it).
 bool isGluedOn(const mount::InstallationPlan& plan, uint32_t p);

@@ -64,7 +64,8 @@ struct CellSet {
     };
     std::vector<HalfSpace> halfSpaces;
     /// Tunnel prisms that bound it (detail/prisms.h): a lining carved along its tunnel lies inside
-    /// its own and outside those of earlier axes; every other piece lies outside all of them.
+    /// its own and outside those that keep the overlaps (of earlier axes; where three cross, of a
+    /// higher TunnelPrism::priority); every other piece lies outside all of them.
     struct PrismBound {
         std::shared_ptr<const TunnelPrism> prism;
         bool isInside = false;
