@@ -198,8 +198,7 @@ constexpr int kLateLevels = 2;
 /// Adds tunnel @p key to @p late at @p level, or raises it there when it is in already.
 void raiseTunnel(std::vector<TunnelKey>& late, const TunnelKey& key, int level) {
     for (TunnelKey& k : late)
-        if (k.axis == key.axis && std::abs(k.centerUMm - key.centerUMm) < 1.0 &&
-            std::abs(k.centerVMm - key.centerVMm) < 1.0) {
+        if (isSameTunnel(k, key, 1.0)) {  // one attempt's prisms are the next one's: the same middles
             k.level = level;
             return;
         }

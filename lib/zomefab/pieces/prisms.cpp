@@ -245,9 +245,15 @@ TunnelPrism tunnelPrism(const TunnelCore& core, const VoxelField& field, double 
     return p;
 }
 
+bool isSameTunnel(const TunnelKey& a, const TunnelKey& b, double toleranceMm) {
+    return a.axis == b.axis && std::abs(a.centerUMm - b.centerUMm) <= toleranceMm &&
+           std::abs(a.centerVMm - b.centerVMm) <= toleranceMm;
+}
+
+TunnelKey tunnelKeyOf(const TunnelPrism& prism) { return {prism.axis, prism.centerUMm, prism.centerVMm}; }
+
 bool isTunnelOf(const TunnelKey& key, const TunnelPrism& prism, double toleranceMm) {
-    return key.axis == prism.axis && std::abs(key.centerUMm - prism.centerUMm) <= toleranceMm &&
-           std::abs(key.centerVMm - prism.centerVMm) <= toleranceMm;
+    return isSameTunnel(key, tunnelKeyOf(prism), toleranceMm);
 }
 
 std::vector<uint32_t> prismOwners(const VoxelField& field, const std::vector<TunnelPrism>& prisms,

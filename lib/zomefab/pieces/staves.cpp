@@ -403,7 +403,7 @@ std::vector<TunnelKey> unheldTunnels(const std::vector<int>& holeOfPiece, const 
         const bool isListed = std::any_of(out.begin(), out.end(), [&](const TunnelKey& k) {
             return isTunnelOf(k, *prism, 0.5 * prism->voxelMm);
         });
-        if (!isListed) out.push_back({prism->axis, prism->centerUMm, prism->centerVMm});
+        if (!isListed) out.push_back(tunnelKeyOf(*prism));
     }
     return out;
 }
@@ -414,12 +414,9 @@ bool isGluedOn(const mount::InstallationPlan& plan, uint32_t p) {
 }
 
 size_t peglessStaves(const mount::InstallationPlan& plan, const std::vector<CellSet>& sets) {
-    std::vector<uint8_t> isGlued(sets.size(), 0);
-    for (const auto& [host, p] : plan.gluedOn)
-        if (p < isGlued.size()) isGlued[p] = 1;
     size_t count = 0;
-    for (size_t p = 0; p < sets.size() && p < plan.holeOfPiece.size(); ++p)
-        count += (plan.holeOfPiece[p] < 0 || isGlued[p]) && isStaveSet(sets[p]) ? 1 : 0;
+    for (uint32_t p = 0; p < sets.size() && p < plan.holeOfPiece.size(); ++p)
+        count += isStaveSet(sets[p]) && (plan.holeOfPiece[p] < 0 || isGluedOn(plan, p)) ? 1 : 0;
     return count;
 }
 

@@ -73,7 +73,11 @@ struct TunnelPrism {
 /// Added to a late tunnel's priority per level (TunnelPrism::priority): above every axis.
 inline constexpr int kLatePriority = 3;
 
-/// Whether @p prism is @p key's tunnel: its axis, its core's middle within @p toleranceMm.
+/// Whether @p a and @p b name one tunnel: the same axis, their cores' middles within @p toleranceMm.
+bool isSameTunnel(const TunnelKey& a, const TunnelKey& b, double toleranceMm);
+/// @p prism's tunnel (at level 1).
+TunnelKey tunnelKeyOf(const TunnelPrism& prism);
+/// Whether @p prism is @p key's tunnel (isSameTunnel).
 bool isTunnelOf(const TunnelKey& key, const TunnelPrism& prism, double toleranceMm);
 
 /// The prism of @p core (the columns of @p field's grid within @p radiusMm of its columns'
