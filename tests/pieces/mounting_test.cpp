@@ -117,6 +117,32 @@ TEST_CASE("mounting: two bodies in each other's way along every direction are st
     CHECK(d.holes[0] == -1);
 }
 
+TEST_CASE("mounting: a body slides past the voxels of one beside it, on either side") {
+    // B (x 0 to 10) pushed off upward passes A (x 11 to 21) beside it, a voxel apart; A pushed off
+    // to the left runs into B. A second part of A (x -10 to -5) makes their shadows meet, so they
+    // are swept. The only order: A first, then B. With the voxel centres on the raster's pixel
+    // corners, A's voxels covered B's last column too (on one side), and neither could go.
+    MountBody a = slab(0, 11, 21, 5, 15), b = slab(1, 0, 10, 0, 10);
+    a.addVoxelsOf(slab(0, -10, -5, 5, 15));
+    a.options = {option(zome::nearestHole({-1, 0, 0}), 2)};
+    b.options = {option(kUp, 2)};
+    const Disassembly d = disassembleAll({a, b});
+    CHECK(d.stuck.empty());
+    CHECK(d.order == std::vector<uint32_t>{0, 1});
+    // Mirrored (B on A's right, A pushed off to the right): the same.
+    MountBody a2 = slab(0, 0, 10, 5, 15), b2 = slab(1, 11, 21, 0, 10);
+    a2.addVoxelsOf(slab(0, 27, 32, 5, 15));
+    a2.options = {option(kRight, 2)};
+    b2.options = {option(kUp, 2)};
+    const Disassembly e = disassembleAll({a2, b2});
+    CHECK(e.stuck.empty());
+    CHECK(e.order == std::vector<uint32_t>{0, 1});
+    // A voxel of B in A's column is met: B one voxel wider, into x = 11.
+    MountBody b3 = slab(1, 0, 11, 0, 10);
+    b3.options = {option(kUp, 2)};
+    CHECK(disassembleAll({a, b3}).stuck.size() == 2);
+}
+
 TEST_CASE("mounting: a cut face lets the neighbour slide along it or leave it, never go into it") {
     // A and B side by side, touching across the plane x = 10.5 (normal from A into B: +x).
     MountBody a = slab(0, 0, 10, 0, 10), b = slab(1, 11, 21, 0, 10);

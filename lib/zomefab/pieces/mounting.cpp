@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "zomefab/core/format.h"
+#include "zomefab/mount/sweep.h"
 #include "zomefab/zome/holes.h"
 
 namespace zomefab::pieces::detail {
@@ -257,6 +258,25 @@ std::vector<uint32_t> unplaceablePieces(const mount::InstallationPlan& plan, con
     for (uint32_t p = 0; p < n && p < input.candidatesByHole.size(); ++p)
         if (plan.holeOfPiece[p] < 0 && !hasHost[p] && input.candidatesByHole[p].empty()) out.push_back(p);
     return out;
+}
+
+bool shadowsMeet(const Box3d& moving, const Box3d& still, const Vec3d& d) {
+    const mount::SweepAxes axes(d);
+    auto range = [](const Box3d& b, const Vec3d& e) {
+        double lo = 1e300, hi = -1e300;
+        for (int k = 0; k < 8; ++k) {
+            const Vec3d p{(k & 1) ? b.max[0] : b.min[0], (k & 2) ? b.max[1] : b.min[1],
+                          (k & 4) ? b.max[2] : b.min[2]};
+            lo = std::min(lo, dot(p, e)), hi = std::max(hi, dot(p, e));
+        }
+        return std::make_pair(lo, hi);
+    };
+    for (const Vec3d& e : {axes.u, axes.v}) {
+        const auto [a0, a1] = range(moving, e);
+        const auto [b0, b1] = range(still, e);
+        if (a1 < b0 || b1 < a0) return false;
+    }
+    return range(still, d).second > range(moving, d).first;
 }
 
 }  // namespace zomefab::pieces::detail

@@ -16,34 +16,21 @@
 
 namespace zomefab::pieces::detail {
 
-bool shadowsMeet(const Box3d& moving, const Box3d& still, const Vec3d& d) {
-    const mount::SweepAxes axes(d);
-    auto range = [](const Box3d& b, const Vec3d& e) {
-        double lo = 1e300, hi = -1e300;
-        for (int k = 0; k < 8; ++k) {
-            const Vec3d p{(k & 1) ? b.max[0] : b.min[0], (k & 2) ? b.max[1] : b.min[1],
-                          (k & 4) ? b.max[2] : b.min[2]};
-            lo = std::min(lo, dot(p, e)), hi = std::max(hi, dot(p, e));
-        }
-        return std::make_pair(lo, hi);
-    };
-    for (const Vec3d& e : {axes.u, axes.v}) {
-        const auto [a0, a1] = range(moving, e);
-        const auto [b0, b1] = range(still, e);
-        if (a1 < b0 || b1 < a0) return false;
-    }
-    return range(still, d).second > range(moving, d).first;
-}
-
 namespace {
 
-/// Does @p moving, pushed off along @p d, run into @p still's voxels? A voxel of tolerance: two
-/// neighbours' voxels across their cut face are a voxel apart (the face itself is tested exactly
-/// by facesAllow). Only asked where shadowsMeet (blockersOf tests that first, before its cache).
+/// Does @p moving, pushed off along @p d, run into @p still's voxels? Only a voxel in the same column
+/// along d is met, not one beside it (a cut face's two sides are a voxel apart; the face itself is
+/// tested exactly by facesAllow): the pixels are voxels centred, along a grid axis, on the voxel
+/// centres (the bounds grown by half a voxel), and an obstacle voxel is drawn just under half a voxel
+/// wide. Drawn from the pixels' corners, it covered four pixels: the cheese at 700 mm, a mouth ring
+/// slid out of its mouth met the face pieces beside its rim (docs/mounting.md, "Order"). Only asked
+/// where shadowsMeet (blockersOf tests that first, before its cache).
 bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, double voxelMm,
                bool isTouching) {
+    const double stillRadiusMm = 0.499 * voxelMm, h = 0.5 * voxelMm;
     Box3d bounds = moving.bounds;
     bounds.expand(still.bounds.min), bounds.expand(still.bounds.max);
+    bounds.expand(sub(bounds.min, {h, h, h})), bounds.expand(add(bounds.max, {h, h, h}));
     const mount::SweepAxes axes(d);
     // Neighbours: a voxel of one near their cut face (kNearCutLayers) meeting a voxel of the other
     // near it is left to facesAllow (seen along a face nearly parallel to d, the voxels on its two
@@ -57,7 +44,7 @@ bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, 
     mount::DepthRaster stillFar = raster(true), movingFar = raster(false);
     if (!isTouching) {
         for (size_t i = 0; i < still.voxels.size(); ++i)
-            stillFar.addPoint(still.voxels[i], 0.5 * voxelMm, uint32_t(i));
+            stillFar.addPoint(still.voxels[i], stillRadiusMm, uint32_t(i));
         for (size_t i = 0; i < moving.voxels.size(); ++i)
             movingFar.addPoint(moving.voxels[i], 0.0, uint32_t(i));
         return mount::worstHit(stillFar, movingFar, voxelMm).isHit;
@@ -77,7 +64,7 @@ bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, 
             if (layer == 0) away.addPoint(body.voxels[i], radiusMm, uint32_t(i));
         }
     };
-    draw(still, moving, 0.5 * voxelMm, stillNear, stillFar, stillAway);
+    draw(still, moving, stillRadiusMm, stillNear, stillFar, stillAway);
     draw(moving, still, 0.0, movingNear, movingFar, movingAway);
     return mount::worstHit(stillFar, movingFar, voxelMm).isHit ||
            mount::worstHit(stillAway, movingNear, voxelMm).isHit ||
