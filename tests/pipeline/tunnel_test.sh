@@ -35,6 +35,7 @@ python3 -c "
 import json, sys
 v = json.load(open('$out/report.json'))['verify']
 pieces = json.load(open('$out/pieces/pieces.json'))['pieces']
+# The rings: glued on, no pegs, going on along the tunnel (the grid's x axis).
 rings = [p for p in v['per_piece'] if p['glued_on'] and p['tenons'] == 0 and
          abs(abs(pieces[p['piece']]['direction']['grid'][0]) - 1) < 1e-6]
 print(f\"verified: {v['passed']}, {len(v['per_piece'])} pieces in {v['bodies']} steps, {len(rings)} rings along the tunnel\")
