@@ -181,6 +181,27 @@ TEST_CASE("mounting: a body no peg can hold is glued onto a piece put on before 
     CHECK(disassembleAll({a, c}, faces).holes[1] == -1);
 }
 
+TEST_CASE("mounting: a mouth ring slid into its mouth is glued on across a face along its way") {
+    // A holds; C lies beside A across the plane x = 10.5 and can only leave upward, along that face:
+    // the 60° rule finds no face to glue it on across; as a mouth ring leaving its mouth upward (a
+    // sleeve glued round its outside) it goes on after A, glued onto it.
+    MountBody a = slab(0, 0, 10, 0, 10), c = slab(1, 11, 21, 0, 10);
+    nearEachOther(a, c);
+    const FaceContacts faces = {{{0, 1}, {CutContact{{1, 0, 0}, 400}}}};
+    a.options = {option(kDown, 2)};
+    c.glueOptions = {option(kUp, 0)};
+    CHECK(disassembleAll({a, c}, faces).holes[1] == -1);
+    c.sleeveGrid = {0, 0, 1};
+    const Disassembly d = disassembleAll({a, c}, faces);
+    CHECK(d.stuck.empty());
+    CHECK(d.order == std::vector<uint32_t>{0, 1});
+    CHECK(d.holes[1] == kUp);
+    CHECK(d.gluedOn == std::vector<std::pair<uint32_t, uint32_t>>{{0, 1}});
+    // Only along its way out: a sleeve whose mouth faces elsewhere is not glued on.
+    c.sleeveGrid = {1, 0, 0};
+    CHECK(disassembleAll({a, c}, faces).holes[1] == -1);
+}
+
 TEST_CASE("mounting: a piece glued on goes on before its only host leaves") {
     // A holds; C sits on A, D beside C (across x = 10.5). Neither C nor D has pegs: D can only be
     // glued onto C, so C must not be taken away first, though it comes first by index.

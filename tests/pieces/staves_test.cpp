@@ -8,6 +8,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <tuple>
 #include <vector>
 
 #include "tunnel_fixtures.h"
@@ -16,6 +17,28 @@
 
 using namespace zomefab;
 using namespace zomefab::pieces::detail;
+
+namespace {
+
+/// A planner's input of @p n staves of one tunnel along x sliding out toward +x, the p-th at
+/// @p ringOf(p) = (−its ring's depth, whether a side stave, its lift's sign) in its rank.
+template <class RingOf>
+PlannerInput stavesAlongX(uint32_t n, RingOf ringOf) {
+    PlannerInput input;
+    input.pieces.resize(n);
+    input.staves.resize(n);
+    for (uint32_t p = 0; p < n; ++p) {
+        const auto [negDepth, isSide, lift] = ringOf(p);
+        Stave st;
+        st.slideGrid = {1, 0, 0};
+        st.isSide = isSide;
+        st.rank = {0, 10.0, 20.0, 1.0, negDepth, isSide ? 0 : 1, lift};
+        input.staves[p] = st;
+    }
+    return input;
+}
+
+}  // namespace
 
 TEST_CASE(
     "staveOf: a stave slides out of its nearer mouth, is lifted across its axis, and takes only directions "
@@ -294,16 +317,10 @@ TEST_CASE(
     // Two rings of a tunnel along x sliding out toward +x: pieces 0-3 the deeper ring (0, 1 sides;
     // 2, 3 top and bottom), 4-7 the shallower. Holes hold all but 2 and 3 (2 shares seams with both
     // held sides, 3 only with 2: a chain) and 6 (no seam large enough with a stave on before it).
-    PlannerInput input;
-    input.pieces.resize(8);
-    input.staves.resize(8);
-    for (uint32_t p = 0; p < 8; ++p) {
-        Stave st;
-        st.slideGrid = {1, 0, 0};
-        st.isSide = p % 4 < 2;
-        st.rank = {0, 10.0, 20.0, 1.0, p < 4 ? -160.0 : -80.0, st.isSide ? 0 : 1, p % 2 ? -1.0 : 1.0};
-        input.staves[p] = st;
-    }
+    const PlannerInput input = stavesAlongX(8, [](uint32_t p) {
+        const bool isSide = p % 4 < 2;
+        return std::make_tuple(p < 4 ? -160.0 : -80.0, isSide, p % 2 ? -1.0 : 1.0);
+    });
     FaceContacts faces;
     auto seam = [&](uint32_t a, uint32_t b, size_t voxelFaces) {
         faces[{std::min(a, b), std::max(a, b)}].push_back({{0, 1, 0}, voxelFaces, true});
@@ -337,4 +354,96 @@ TEST_CASE(
     plan.holeOfPiece[2] = order.holes[2];
     CHECK(isGluedOn(plan, 2));
     CHECK_FALSE(isGluedOn(plan, 0));
+}
+
+TEST_CASE("orderStaveRings: a ring with a stave no hole holds waits for the staves it can be glued onto") {
+    // Three rings of one stave each, in rank order: ring 0's stave (0) no hole holds, and its only
+    // seam is with ring 2's stave (2); rings 1 and 2 are held, ring 1 in ring 2's way.
+    StaveRings g;
+    g.ringOf = {0, 1, 2};
+    g.later = {{}, {2}, {}};
+    g.isHeld = {0, 1, 1};
+    g.canSlideIn = {1, 1, 1};
+    g.seamMates = {{2}, {}, {0}};
+    size_t cycles = 9;
+    CHECK(orderStaveRings(g, &cycles) == std::vector<size_t>{1, 2, 0});
+    CHECK(cycles == 0);
+    // With ring 2 in ring 0's way out, ring 0 goes on before it all the same (and stays unheld).
+    g.later = {{2}, {2}, {}};
+    CHECK(orderStaveRings(g) == std::vector<size_t>{1, 0, 2});
+    // A stave that cannot slide in (no hole along its slide) is glued onto nothing: its ring goes
+    // last, where it keeps nothing waiting.
+    g.later = {{}, {2}, {}};
+    g.canSlideIn = {0, 1, 1};
+    CHECK(orderStaveRings(g) == std::vector<size_t>{1, 2, 0});
+    // Rings in each other's way: the first left in rank order goes on, and the cycle is counted.
+    g.canSlideIn = {1, 1, 1};
+    g.later = {{1}, {0}, {}};
+    CHECK(orderStaveRings(g, &cycles) == std::vector<size_t>{2, 0, 1});
+    CHECK(cycles == 1);
+}
+
+TEST_CASE("orderStaveRings: a ring's staves glued round the ring count as held; the rest keep rank order") {
+    // Ring 0: staves 0 (held), 1 (glued onto 0), 2 (glued onto 1: a chain); ring 1: stave 3, held.
+    StaveRings g;
+    g.ringOf = {0, 0, 0, 1};
+    g.later = {{}, {}};
+    g.isHeld = {1, 0, 0, 1};
+    g.canSlideIn = {1, 1, 1, 1};
+    g.seamMates = {{1}, {0, 2}, {1}, {}};
+    CHECK(orderStaveRings(g) == std::vector<size_t>{0, 1, 2, 3});
+    // A stave of ring 0 that is only glued onto a stave that is itself unheld waits for nothing.
+    g.isHeld = {0, 0, 0, 1};
+    g.seamMates = {{}, {2}, {1}, {}};
+    CHECK(orderStaveRings(g) == std::vector<size_t>{3, 0, 1, 2});
+}
+
+TEST_CASE("staveRings: a stave in another's way out along its tunnel puts that one's ring later") {
+    // A tunnel along x whose staves slide out toward +x: stave 0 deep (x 0-10), stave 1 shallower
+    // in the same columns (x 20-30), stave 2 shallower still but beside them (y 20-30).
+    auto box = [](uint32_t p, double x0, double y0) {
+        MountBody b;
+        b.pieces = {p};
+        for (double x = x0; x <= x0 + 10; x += 1.0)
+            for (double y = y0; y <= y0 + 10; y += 1.0)
+                for (double z = 0; z <= 10; z += 1.0) {
+                    b.voxels.push_back({x, y, z});
+                    b.nearCutOf.push_back({kNone, kNone});
+                    b.cutLayer.push_back({0, 0});
+                    b.bounds.expand({x, y, z});
+                }
+        return b;
+    };
+    const std::vector<MountBody> bodies{box(0, 0, 0), box(1, 20, 0), box(2, 40, 20)};
+    const PlannerInput input =
+        stavesAlongX(3, [](uint32_t p) { return std::make_tuple(-100.0 + 30.0 * p, true, 1.0); });
+    const StaveOrder order{{0, 1, 2}, {7, 7, -1}, {}};
+    const StaveRings g = staveRings(order, bodies, input, {}, Transform4d::identity(), 1.0);
+    CHECK(g.ringOf == std::vector<size_t>{0, 1, 2});
+    REQUIRE(g.later.size() == 3);
+    CHECK(g.later[0] == std::vector<size_t>{1});
+    CHECK(g.later[1].empty());
+    CHECK(g.later[2].empty());
+    CHECK(g.isHeld == std::vector<uint8_t>{1, 1, 0});
+    CHECK(g.canSlideIn == std::vector<uint8_t>{1, 1, 1});  // a blue hole along x
+}
+
+TEST_CASE("mouthRingSlide: a mouth ring slides out of the mouth on its side of the tunnel's split") {
+    auto prism = std::make_shared<TunnelPrism>();
+    prism->axis = 2, prism->loMm = 0.0, prism->hiMm = 700.0;
+    prism->isStaved = true;
+    CellSet ring;
+    ring.isLining = true;
+    ring.isMouthRing = true;
+    ring.prisms = {{prism, true}};
+    const std::vector<Vec3d> top{{0, 0, 650}, {0, 0, 690}}, bottom{{0, 0, 10}, {0, 0, 70}};
+    REQUIRE(mouthRingSlide(ring, top).has_value());
+    CHECK(*mouthRingSlide(ring, top) == Vec3d{0, 0, 1});
+    CHECK(*mouthRingSlide(ring, bottom) == Vec3d{0, 0, -1});
+    // A stave, or a lining of a prism not staved, is no mouth ring.
+    ring.isMouthRing = false;
+    CHECK_FALSE(mouthRingSlide(ring, top).has_value());
+    ring.isMouthRing = true;
+    prism->isStaved = false;
+    CHECK_FALSE(mouthRingSlide(ring, top).has_value());
 }

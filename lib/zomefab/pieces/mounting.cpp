@@ -242,6 +242,8 @@ MountBody makeBody(const std::vector<uint32_t>& members, const PlannerInput& inp
         }
     }
     body.options = rankedOptions(byHole, size_t(std::max(1, maxPerPiece)) * body.pieces.size());
+    if (body.pieces.size() == 1 && body.pieces[0] < input.sleeves.size())
+        body.sleeveGrid = input.sleeves[body.pieces[0]];
     testPaths(body, sweeps, voxelMm, freeWanted);
     return body;
 }

@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <set>
 #include <tuple>
@@ -16,15 +17,7 @@
 
 namespace zomefab::pieces::detail {
 
-namespace {
-
-/// Does @p moving, pushed off along @p d, run into @p still's voxels? Only a voxel in the same column
-/// along d is met, not one beside it (a cut face's two sides are a voxel apart; the face itself is
-/// tested exactly by facesAllow): the pixels are voxels centred, along a grid axis, on the voxel
-/// centres (the bounds grown by half a voxel), and an obstacle voxel is drawn just under half a voxel
-/// wide. Drawn from the pixels' corners, it covered four pixels: the cheese at 700 mm, a mouth ring
-/// slid out of its mouth met the face pieces beside its rim (docs/mounting.md, "Order"). Only asked
-/// where shadowsMeet (blockersOf tests that first, before its cache).
+// The raster's pixels are voxels centred on the voxel centres (detail/mounting.h says why).
 bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, double voxelMm,
                bool isTouching) {
     const double stillRadiusMm = 0.499 * voxelMm, h = 0.5 * voxelMm;
@@ -71,9 +64,6 @@ bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, 
            mount::worstHit(stillNear, movingAway, voxelMm).isHit;
 }
 
-/// Whether the cut faces between @p still and @p moving let @p moving go on after @p still along
-/// @p d (mount::faceOrder for every plane they share: its path does not go into still). True when
-/// they share no face; @p isTouching says whether they do.
 bool facesAllow(const MountBody& still, const MountBody& moving, const Vec3d& d, const FaceContacts& faces,
                 bool* isTouching) {
     bool isOk = true;
@@ -93,6 +83,8 @@ bool facesAllow(const MountBody& still, const MountBody& moving, const Vec3d& d,
         }
     return isOk;
 }
+
+namespace {
 
 /// The body names and a list of pieces for messages: "piece 3", "pieces 3 + 4 (glued)".
 std::string bodyName(const MountBody& b) {
@@ -155,12 +147,18 @@ size_t glueStuck(Bodies& bodies, const Disassembly& parts, const PlannerInput& i
         const std::vector<uint32_t>& list = parts.stuckBlockers[k];
         return std::find(list.begin(), list.end(), other) != list.end();
     };
+    auto hasStave = [&](const MountBody& body) {
+        return std::any_of(body.pieces.begin(), body.pieces.end(), [&](uint32_t p) {
+            return p < input.staves.size() && input.staves[p].has_value();
+        });
+    };
     std::vector<std::tuple<int, size_t, uint32_t, uint32_t>> pairs;  // (−kind, −contact, a, b)
     for (size_t i = 0; i < parts.stuck.size(); ++i)
         for (uint32_t b = 0; b + fixedCount < bodies.list.size(); ++b) {
             const uint32_t a = parts.stuck[i];
             const auto other = std::find(parts.stuck.begin(), parts.stuck.end(), b);
             if (b == a || (other != parts.stuck.end() && b < a)) continue;  // each stuck pair once
+            if (hasStave(bodies.list[a]) || hasStave(bodies.list[b])) continue;  // never glued into groups
             const size_t contact = bodyContact(bodies.list[a], bodies.list[b], faces);
             if (contact == 0) continue;
             int kind = 0;
@@ -405,12 +403,13 @@ Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts
         return std::all_of(blockers.begin(), blockers.end(), [&](uint32_t a) { return !isLeft[a]; });
     };
     // The faces a hosted body can be glued on across along direction k now: hosts in place, pins
-    // straight enough.
+    // straight enough (any, for a mouth ring slid into its mouth).
     auto gluable = [&](uint32_t b, size_t k) {
         const Vec3d d = gridDirection(holeOf(bodies, state, b, k), frameToGridMm);
         std::vector<const HostFace*> list;
+        const bool isSleeve = dot(d, bodies[b].sleeveGrid) > std::cos(kPi / 180.0);
         for (const HostFace& h : hosts[b])
-            if (isLeft[h.body] && dot(d, h.normal) >= glueOn.minCosine) list.push_back(&h);
+            if (isLeft[h.body] && (isSleeve || dot(d, h.normal) >= glueOn.minCosine)) list.push_back(&h);
         return list;
     };
     // A body whose removal would leave a body that can only be glued on with nothing to be glued
@@ -510,18 +509,9 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
         context.throwIfCancelled();
     }
     // Staves go on first, in their order, and stay in every other body's way: the fixed bodies at
-    // the end of the list.
-    std::sort(staves.begin(), staves.end(), [&](uint32_t a, uint32_t b) {
-        return std::tie(input.staves[a]->rank, a) < std::tie(input.staves[b]->rank, b);
-    });
-    StaveOrder order{staves, std::vector<int>(staves.size(), -1), {}};
-    std::vector<MountBody> staveBodies;
-    for (size_t k = 0; k < staves.size(); ++k)
-        staveBodies.push_back(
-            staveBody(staves[k], input, sweeps.frameToGridMm(), maxPerPiece, &order.holes[k]));
-    for (size_t k : glueStavesInPlace(order, input, faces, sweeps.frameToGridMm(), voxelMm))
-        bodies.list.push_back(std::move(staveBodies[k]));
-    const size_t fixed = staves.size();
+    // the end of the list (those placed nowhere may go on with the rest, isGluingUnheldStaves).
+    StaveOrder order = placeStaves(staves, input, sweeps, faces, voxelMm, maxPerPiece, context, bodies.list);
+    const size_t fixed = order.pieces.size();
     // A stave no hole holds and none of its ring holds it either leaves no plan to be carried out:
     // the frame must grow toward it first (growFrameForStaves), and an order of the rest is not
     // sought (the cheese at 700 mm: minutes).

@@ -13,6 +13,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 
@@ -170,8 +171,13 @@ void planTenonsToFit(Pieces& out, VoxelField& field, const GridCells& cells, Gro
         planPieces(out, field, cells, grouping, shell, frame, frameToGridMm, fabrication, out.options,
                    canGrow, context);
         // A plan stuck on tunnels that cross is refused whatever the cuts (the cheese at 700 mm
-        // planned a second time, 5 minutes, for the same 257 stuck linings).
-        if (round == kFitRounds || out.crossingTunnelPieces > 0) return;
+        // planned a second time, 5 minutes, for the same 257 stuck linings); so is one with staves
+        // that has no order (the cheese at 700 mm: three rounds of 8 minutes, the same 27 bodies
+        // stuck after each).
+        const bool isStaved = std::any_of(grouping.cellSets.begin(), grouping.cellSets.end(),
+                                          [](const CellSet& set) { return isStaveSet(set); });
+        if (round == kFitRounds || out.crossingTunnelPieces > 0 || (isStaved && !out.plan.isBuildable()))
+            return;
         const size_t cuts =
             splitOverPrinter(out.pieces, grouping, field, cells, out.options.tenons, fabrication.pieceBoxMm(),
                              fabrication.fitMarginMm, out.options.minPieceVolumeMm3, context);

@@ -337,10 +337,15 @@ mount::InstallationPlan planOverCandidates(const Pieces& out, const VoxelField& 
             if (std::optional<Stave> st = staveOf(grouping.cellSets[p], input.pieces[p].voxels)) {
                 input.staves.resize(out.pieces.size());
                 input.staves[p] = st;
+            } else if (std::optional<Vec3d> way =
+                           mouthRingSlide(grouping.cellSets[p], input.pieces[p].voxels)) {
+                input.sleeves.resize(out.pieces.size(), Vec3d{0, 0, 0});
+                input.sleeves[p] = *way;
             }
         // A plan with glued groups of its own is a trial (glueUnderHeld): it gives up where no order
         // exists rather than glue more (each round of that took 4 s on the demo, and never helped).
         input.isGluingStuck = preGlued.empty();
+        input.isGluingUnheldStaves = grouping.isGluingUnheldStaves;
         mount::InstallationPlan plan =
             planMounting(input, sweeps, grouping.faces, field.voxelMm, tenonHoleSet(opt.tenons.holes),
                          opt.tenons.maxPerPiece, context);
@@ -468,6 +473,15 @@ void planMountingAndTenons(Pieces& out, VoxelField& field, const GridCells& cell
     Replanner replanner(out, field, cells, grouping, probe, frame, frameToGridMm, sweeps, remakeSweeps,
                         candidates, lost, opt, context);
     if (opt.isGrowingFrame && canGrow) out.frameStrutsGrown += growFrameForStaves(replanner, canGrow);
+    if (unplacedStaves(out.plan.holeOfPiece, grouping.cellSets) > 0) {
+        // What no peg holds and no stave on before it glues in place goes on with the rest, glued
+        // in place onto what is on by then.
+        grouping.isGluingUnheldStaves = true;
+        out.plan = planOverCandidates(out, field, grouping, sweeps, candidates, lost, opt, context);
+        context.debug("mounting: staves placed nowhere glued in place among the other pieces: " +
+                      std::to_string(unplacedStaves(out.plan.holeOfPiece, grouping.cellSets)) +
+                      " placed nowhere, " + std::to_string(out.plan.problems.size()) + " problems");
+    }
     if (opt.isGrowingFrame && canGrow && opt.tenons.minPerPiece > 0)
         out.frameStrutsGrown += growFrameForPieces(replanner, canGrow);
     mergeUnderHeld(replanner, fabrication);

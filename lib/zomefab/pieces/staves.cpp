@@ -243,6 +243,16 @@ std::optional<Stave> staveOf(const CellSet& set, const std::vector<Vec3d>& voxel
     return st;
 }
 
+std::optional<Vec3d> mouthRingSlide(const CellSet& set, const std::vector<Vec3d>& voxelsMm) {
+    if (!set.isMouthRing || !isStavedLining(set) || voxelsMm.empty()) return std::nullopt;
+    const TunnelPrism* prism = ownPrism(set);
+    double mean = 0.0;
+    for (const Vec3d& x : voxelsMm) mean += x[size_t(prism->axis)];
+    Vec3d way{0, 0, 0};
+    way[size_t(prism->axis)] = mean / double(voxelsMm.size()) >= prism->splitMm() ? 1.0 : -1.0;
+    return way;
+}
+
 void setStaveLifts(Pieces& out, const std::vector<CellSet>& sets, const VoxelField& field,
                    const Transform4d& frameToGridMm, double frameDMinMm) {
     std::vector<int> stepOf(out.pieces.size(), -1);
@@ -292,63 +302,6 @@ MountBody staveBody(uint32_t p, const PlannerInput& input, const Transform4d& fr
             break;
         }
     return body;
-}
-
-std::vector<size_t> glueStavesInPlace(StaveOrder& order, const PlannerInput& input, const FaceContacts& faces,
-                                      const Transform4d& frameToGridMm, double voxelMm) {
-    const size_t n = order.pieces.size();
-    order.hosts.assign(n, {});
-    const GlueOnRule rule;
-    // A ring: the rank's axis, tunnel, mouth and depth (the staves come in rank order: rings in runs).
-    auto ringOf = [&](size_t k) {
-        const auto& r = input.staves[order.pieces[k]]->rank;
-        return std::make_tuple(std::get<0>(r), std::get<1>(r), std::get<2>(r), std::get<3>(r),
-                               std::get<4>(r));
-    };
-    auto sharesSeam = [&](uint32_t p, uint32_t q) {
-        const auto it = faces.find({std::min(p, q), std::max(p, q)});
-        size_t voxelFaces = 0;
-        if (it != faces.end())
-            for (const CutContact& c : it->second) voxelFaces += c.voxelFaces;
-        return rule.isLargeEnough(voxelFaces, voxelMm);
-    };
-    auto holeAlong = [&](uint32_t p) {  // along its slide: it is taken off out of its mouth, straight
-        for (int h = 0; h < zome::kHoleCount; ++h)
-            if (dot(gridDirection(h, frameToGridMm), input.staves[p]->slideGrid) > std::cos(kPi / 180.0))
-                return h;
-        return -1;
-    };
-    std::vector<size_t> perm;  // the new order, old indices: ring by ring, held staves, then glued ones
-    std::vector<uint8_t> isOn(n, 0);
-    for (size_t begin = 0, end = 0; begin < n; begin = end) {
-        while (end < n && ringOf(end) == ringOf(begin)) ++end;
-        for (size_t k = begin; k < end; ++k)
-            if (order.holes[k] >= 0) perm.push_back(k), isOn[k] = 1;
-        // A stave glued in place may hold the next (a chain round the ring).
-        for (bool isGrown = true; isGrown;) {
-            isGrown = false;
-            for (size_t k = begin; k < end; ++k) {
-                const uint32_t p = order.pieces[k];
-                const int along = isOn[k] ? -1 : holeAlong(p);
-                if (along < 0) continue;
-                for (size_t j : perm)
-                    if (sharesSeam(p, order.pieces[j])) order.hosts[k].push_back(order.pieces[j]);
-                if (order.hosts[k].empty()) continue;
-                order.holes[k] = along;
-                perm.push_back(k), isOn[k] = 1, isGrown = true;
-            }
-        }
-        for (size_t k = begin; k < end; ++k)
-            if (!isOn[k]) perm.push_back(k);
-    }
-    StaveOrder sorted;
-    for (size_t k : perm) {
-        sorted.pieces.push_back(order.pieces[k]);
-        sorted.holes.push_back(order.holes[k]);
-        sorted.hosts.push_back(order.hosts[k]);
-    }
-    order = std::move(sorted);
-    return perm;
 }
 
 void addStaveSteps(mount::InstallationPlan& plan, const PlannerInput& input, const StaveOrder& order,

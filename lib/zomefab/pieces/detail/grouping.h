@@ -79,6 +79,9 @@ struct Grouping {
     std::vector<TunnelKey> lateTunnels;
     /// After a plan that cannot be carried out: the tunnels of the staves it placed nowhere.
     std::vector<TunnelKey> unheldTunnels;
+    /// Staves still placed nowhere once the frame has grown toward them go on with the other
+    /// pieces, glued in place (PlannerInput::isGluingUnheldStaves).
+    bool isGluingUnheldStaves = false;
 };
 
 /// The whole grouping (docs/pieces.md §1, steps 2–4): components, groups, merges of orphans and

@@ -78,6 +78,12 @@ struct MountBody {
     /// every direction of the hole set, tested, for gluing it onto a piece already in place as it
     /// goes on. Empty otherwise.
     std::vector<DirectionOption> glueOptions;
+    /// A mouth ring alone (PlannerInput::sleeves): its way out of its mouth (grid, unit), else zero.
+    /// Along it (within a degree) the ring may be glued on across any face large enough, which the
+    /// 60° of GlueOnRule would refuse: a sleeve slid into its mouth, glued round its outside to the
+    /// pieces round the rim (its deep end opens into a crossing; docs/mounting.md, "Three tunnels
+    /// through one point").
+    Vec3d sleeveGrid{0, 0, 0};
 
     /// The best direction with a free path and at least one tenon, or null.
     const DirectionOption* bestFree() const;
@@ -124,6 +130,15 @@ struct PlannerInput {
     /// Per piece, the stave it is (detail/staves.h): staves go on first, in their order, along two
     /// legs; never glued. Empty: no piece is one.
     std::vector<std::optional<Stave>> staves;
+    /// Per piece: a mouth ring's way out of its mouth along its tunnel (grid, unit; mouthRingSlide),
+    /// else zero. Empty: no piece is one.
+    std::vector<Vec3d> sleeves;
+    /// A stave no hole holds and none on before it to glue it in place onto (glueStavesInPlace)
+    /// goes on with the other pieces instead of before them: slid straight to its place along its
+    /// tunnel and glued on across any face large enough (MountBody::sleeveGrid), onto whatever is
+    /// on by then (a mouth ring at its deep end). Off: such a stave leaves the plan at once, placed
+    /// nowhere, so that the frame grows toward it first (growFrameForStaves).
+    bool isGluingUnheldStaves = false;
 };
 PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
                           const std::vector<TenonCandidate>& candidates);
@@ -154,16 +169,72 @@ struct StaveOrder {
     std::vector<std::vector<uint32_t>> hosts;  ///< per stave; empty: its pegs hold it
 };
 
+/// The hole along @p stave's slide, out of its mouth (a stave glued in place is taken off along it,
+/// straight), or −1.
+int holeAlongSlide(const Stave& stave, const Transform4d& frameToGridMm);
+
+/// @p order with its k-th stave (piece, hole, hosts) the old @p perm[k]-th.
+StaveOrder permuted(const StaveOrder& order, const std::vector<size_t>& perm);
+
 /// Staves no hole holds (−1 in @p order.holes) that share a seam or a ring's cut face large enough to
-/// glue across (GlueOnRule) with staves on before them are glued in place onto those: such a stave
-/// slides along its tunnel straight to its place, along its ring's seams, after the staves of its
-/// ring that holes hold (and after those glued in place it is glued onto: a chain round the ring);
-/// its hole is the one along its slide, out of its mouth (none there: it stays unheld). The staves
-/// keep their rank's order of rings; in a ring those holes hold come first, in rank order, then the
-/// glued ones as they were found, then those still unheld. Returns the permutation applied (the new
-/// k-th stave is the old result[k]).
+/// glue across (GlueOnRule) with staves held or glued in place on before them are glued in place
+/// onto those: such a stave slides along its tunnel straight to its place, along its ring's seams,
+/// after the staves of its ring that holes hold (and after those glued in place it is glued onto: a
+/// chain round the ring); its hole is the one along its slide, out of its mouth (none there: it
+/// stays unheld). The staves keep @p order's order of rings (orderStaveRings); in a ring those holes
+/// hold come first, in @p order's order, then the glued ones as they were found, then those still
+/// unheld. Returns the permutation applied (the new k-th stave is the old result[k]).
 std::vector<size_t> glueStavesInPlace(StaveOrder& order, const PlannerInput& input, const FaceContacts& faces,
                                       const Transform4d& frameToGridMm, double voxelMm);
+
+/// The staves of a plan as rings (runs of one ring in the rank's order) and what orders them.
+struct StaveRings {
+    std::vector<size_t> ringOf;  ///< per stave (its index in the order): its ring, numbered in rank order
+    /// Per ring: the rings a stave of which lies in the way out of one of its own staves (or whose
+    /// cut faces say so): they go on after it.
+    std::vector<std::vector<size_t>> later;
+    std::vector<uint8_t> isHeld;      ///< per stave: a hole holds it
+    std::vector<uint8_t> canSlideIn;  ///< per stave: a hole lies along its slide (it can be glued in place)
+    std::vector<std::vector<size_t>> seamMates;  ///< per stave: those it shares a seam to glue across with
+};
+
+/// The rings of @p order (its staves in rank order, each one's hole; @p bodies theirs): stave j lies
+/// in stave k's way when k, slid out of its mouth along its tunnel, meets it (sweepHits, facesAllow;
+/// the lift toward the axis meets only k's own ring). Staves j and k share a seam when it is large
+/// enough to glue across (GlueOnRule).
+StaveRings staveRings(const StaveOrder& order, const std::vector<MountBody>& bodies,
+                      const PlannerInput& input, const FaceContacts& faces, const Transform4d& frameToGridMm,
+                      double voxelMm);
+
+/// An order of @p g's rings in which each goes on before those in its staves' ways (StaveRings::
+/// later): of the rings whose ways allow it, the first in rank order all of whose staves are then
+/// held or glued in place (glueStavesInPlace's rule onto the staves on before), else the first in
+/// rank order. So a ring with a stave no hole holds waits, as long as its ways allow, for staves of
+/// other tunnels it could be glued onto (the cheese at 700 mm: the rank put an x tunnel's ring before
+/// the y and z staves round the crossing at its deep end). Where the ways make a cycle, the first
+/// ring left in rank order goes on (@p cyclesBroken counts them). Returns the staves' indices in
+/// the new order, ring by ring, each ring's in its own order.
+std::vector<size_t> orderStaveRings(const StaveRings& g, size_t* cyclesBroken = nullptr);
+
+/// For the debug output: per stave @p order places nowhere (its staves in the final order, the k-th
+/// the @p rankOf[k]-th of @p byRank, which @p g and @p bodies follow), where it is and the staves it
+/// shares a seam with: held, glued or not, before or after it, and whose way each lies in; then
+/// every piece it touches, with the area.
+std::vector<std::string> unheldStaveNotes(const StaveOrder& byRank, const StaveRings& g,
+                                          const StaveOrder& order, const std::vector<size_t>& rankOf,
+                                          const std::vector<MountBody>& bodies, const FaceContacts& faces,
+                                          double voxelMm);
+
+/// The staves (pieces @p staves) in the order they go on, their bodies appended to @p list: rings
+/// in the order their ways allow (staveRings, orderStaveRings), in each the held staves, then those
+/// glued in place onto staves on before them (glueStavesInPlace), then those placed nowhere (the
+/// debug output says why, unheldStaveNotes). With PlannerInput::isGluingUnheldStaves, staves placed
+/// nowhere that can slide in along their tunnel become movable bodies with one glue option along
+/// it, their slide their sleeve (MountBody::sleeveGrid), put before the rest. Returns the order of
+/// the fixed staves, whose bodies are the last of @p list.
+StaveOrder placeStaves(std::vector<uint32_t> staves, const PlannerInput& input, const FrameSweeps& sweeps,
+                       const FaceContacts& faces, double voxelMm, int maxPerPiece, const RunContext& context,
+                       std::vector<MountBody>& list);
 
 /// The steps of @p order's staves put before @p plan's: each slid in along its tunnel and held
 /// kStaveLiftMm off its place, or, glued in place, slid straight to it (its hosts glued on); a
@@ -183,6 +254,23 @@ Vec3d gridDirection(int hole, const Transform4d& frameToGridMm);
 /// Could the boxes meet when @p moving is pushed off along @p d past @p still? Their shadows on
 /// the plane normal to d overlap, and something of @p still lies ahead of @p moving's rear.
 bool shadowsMeet(const Box3d& moving, const Box3d& still, const Vec3d& d);
+
+/// Does @p moving, pushed off along @p d, run into @p still's voxels? Only a voxel in the same column
+/// along d is met, not one beside it (a cut face's two sides are a voxel apart; the face itself is
+/// tested exactly by facesAllow): the pixels are voxels centred, along a grid axis, on the voxel
+/// centres (the bounds grown by half a voxel), and an obstacle voxel is drawn just under half a voxel
+/// wide. Drawn from the pixels' corners, it covered four pixels: the cheese at 700 mm, a mouth ring
+/// slid out of its mouth met the face pieces beside its rim (docs/mounting.md, "Order"). Only asked
+/// where shadowsMeet (blockersOf tests that first, before its cache). @p isTouching: the two share
+/// a cut face (facesAllow), near which their voxels are swept apart.
+bool sweepHits(const MountBody& moving, const MountBody& still, const Vec3d& d, double voxelMm,
+               bool isTouching);
+
+/// Whether the cut faces between @p still and @p moving let @p moving go on after @p still along
+/// @p d (mount::faceOrder for every plane they share: its path does not go into still). True when
+/// they share no face; @p isTouching says whether they do.
+bool facesAllow(const MountBody& still, const MountBody& moving, const Vec3d& d, const FaceContacts& faces,
+                bool* isTouching);
 
 /// Fills @p body's glueOptions when no peg can hold it: every hole of @p holes, each tested for a
 /// free path (in parallel).

@@ -103,6 +103,11 @@ std::array<Vec3d, 4> staveLifts(int axis, bool isTurned);
 /// lines no staved prism.
 std::optional<Stave> staveOf(const CellSet& set, const std::vector<Vec3d>& voxelsMm);
 
+/// A mouth ring's way out of its mouth along its tunnel (grid, unit): toward the mouth on the side of
+/// its tunnel's split its voxels' centres (@p voxelsMm, grid mm) lie on, as a stave's slide; none
+/// for a piece that is not a mouth ring (CellSet::isMouthRing).
+std::optional<Vec3d> mouthRingSlide(const CellSet& set, const std::vector<Vec3d>& voxelsMm);
+
 /// A staved lining at a mouth no longer than this many walls stays one ring (cutStaves).
 inline constexpr double kMouthRingWalls = 3.0;
 
