@@ -286,6 +286,42 @@ TEST_CASE("pieces: a speck of shell that touches nothing is dropped, not joined 
         CHECK(withSpeck.pieces[p].shellVolumeMm3 == doctest::Approx(plain.grouping.pieces[p].shellVolumeMm3));
 }
 
+TEST_CASE("pieces: an island of the wall too small for a piece that touches no other is left out") {
+    // 27 inside voxels in the hollow, 60 mm from the wall: larger than a speck, smaller than the
+    // smallest piece. Nothing could hold it (no tenon, no face to glue it onto): it is left out and
+    // counted; with no smallest piece it stays a piece of its own.
+    openvdb::FloatGrid::Ptr grid = sdf::levelSetGrid(shell())->deepCopy();
+    const int cx = int(std::lround(30.0 / kVoxel));
+    for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dz = -1; dz <= 1; ++dz) {
+                const openvdb::Coord c(cx + dx, dy, dz);
+                REQUIRE(grid->tree().getValue(c) > 0);
+                grid->tree().setValueOn(c, -0.3f);
+            }
+    const partition::PartitionResult quadrants = quadrantCells(-5.3, 10.4);
+    const GridCells cells = toGridCells(quadrants.cells, Transform4d::identity());
+    const double crumbMm3 = 27.0 * kVoxel * kVoxel * kVoxel;
+    for (const double minVolumeMm3 : {crumbMm3 * 1.5, 0.0}) {
+        VoxelField field = buildField(*grid);
+        const size_t slot = field.slotAt({30.0, 0, 0});
+        REQUIRE(slot != SIZE_MAX);
+        REQUIRE(field.isInside(slot));
+        labelCells(field, cells);
+        const Grouping g = groupPieces(field, cells, quadrants.pieces, Transform4d::identity(), 10.0,
+                                       minVolumeMm3, RunContext::silent());
+        if (minVolumeMm3 > 0) {
+            CHECK_FALSE(field.isInside(slot));
+            CHECK(g.pieces.size() == 4);
+            CHECK(g.isolatedSlivers == 1);
+        } else {
+            CHECK(field.isInside(slot));
+            CHECK(g.pieces.size() == 5);
+            CHECK(g.isolatedSlivers == 0);
+        }
+    }
+}
+
 TEST_CASE("pieces: a cell shared by two requests and a cell no request names") {
     // Cells: 0 = x ≥ 0 and 1 = x < 0. Both requests name cell 0 (its shell part is connected, so it
     // goes whole to the request whose surface box holds most of it); no request names cell 1,

@@ -3,6 +3,7 @@
 #include "zomefab/pieces/detail/grouping.h"
 
 #include <algorithm>
+#include <cmath>
 #include <tuple>
 
 #include "zomefab/core/disjoint_sets.h"
@@ -135,25 +136,43 @@ struct Merger {
     }
 };
 
+/// What dropSpecks left out: voxels in specks, and crumbs (islands larger than a speck).
+struct Dropped {
+    size_t speckVoxels = 0, crumbs = 0, crumbVoxels = 0;
+};
+
 /// Drops the specks: islands of the shell (components joined by their contacts, across cells) of
 /// at most kSpeckVoxels voxels, a corner of a cell the cut grazed or a thread of wall thinner than
 /// a voxel. Their voxels become outside voxels (φ mirrored), so no piece holds them: the mesher
 /// would drop them anyway (components under a voxel's volume), and joined to a piece they made it
 /// two islands that no plane cuts into connected halves and whose far crumb meets the frame along
-/// every direction (the dino at 450 mm: "piece 1: no direction to push it on along"). Returns how
-/// many voxels were dropped; the caller finds the components again.
-size_t dropSpecks(VoxelField& field, const std::vector<Component>& comps, const Contacts& contacts) {
+/// every direction (the dino at 450 mm: "piece 1: no direction to push it on along"). So are the
+/// crumbs, islands of fewer than @p maxCrumbVoxels: too small for a tenon, and touching no other
+/// piece to be glued onto, nothing could hold one (the cheese at 700 mm: a 52 mm³ piece the plan
+/// could place nowhere); never the largest island. The caller finds the components again.
+Dropped dropSpecks(VoxelField& field, const std::vector<Component>& comps, const Contacts& contacts,
+                   size_t maxCrumbVoxels) {
     DisjointSets islands(comps.size());
     for (const auto& [pair, count] : contacts) islands.unite(pair.first, pair.second);
     std::vector<size_t> islandVoxels(comps.size(), 0);
     for (size_t k = 0; k < comps.size(); ++k) islandVoxels[islands.find(uint32_t(k))] += comps[k].voxels;
-    size_t dropped = 0;
+    // The largest island is never a crumb (a smallest piece larger than the whole shell keeps it whole).
+    const size_t largest =
+        islandVoxels.empty() ? 0 : *std::max_element(islandVoxels.begin(), islandVoxels.end());
+    auto isCrumb = [&](size_t voxels) {
+        return voxels > kSpeckVoxels && voxels < maxCrumbVoxels && voxels < largest;
+    };
+    Dropped out;
+    for (size_t k = 0; k < comps.size(); ++k)
+        if (islands.find(uint32_t(k)) == k && isCrumb(islandVoxels[k])) ++out.crumbs;
     for (size_t s = 0; s < field.phi.size(); ++s) {
-        if (!field.isInside(s) || islandVoxels[islands.find(field.owner[s])] > kSpeckVoxels) continue;
+        if (!field.isInside(s)) continue;
+        const size_t voxels = islandVoxels[islands.find(field.owner[s])];
+        if (voxels > kSpeckVoxels && !isCrumb(voxels)) continue;
         field.phi[s] = -field.phi[s];
-        ++dropped;
+        ++(voxels > kSpeckVoxels ? out.crumbVoxels : out.speckVoxels);
     }
-    return dropped;
+    return out;
 }
 
 /// Piece ids: roots ordered by the lowest group they hold (then by their first voxel).
@@ -419,10 +438,19 @@ Grouping groupPieces(VoxelField& field, const GridCells& cells, const std::vecto
     const double voxelVolume = field.voxelMm * field.voxelMm * field.voxelMm;
     std::vector<Component> comps = findComponents(field);
     Contacts contacts = componentContacts(field);
-    if (const size_t specks = dropSpecks(field, comps, contacts); specks > 0) {
-        context.detail(formatNumber(double(specks) * voxelVolume, 4) +
+    const auto maxCrumbVoxels = size_t(std::ceil(minPieceVolumeMm3 / voxelVolume));
+    const Dropped dropped = dropSpecks(field, comps, contacts, maxCrumbVoxels);
+    if (dropped.speckVoxels > 0)
+        context.detail(formatNumber(double(dropped.speckVoxels) * voxelVolume, 4) +
                        " mm³ of the shell in specks of at most " + std::to_string(kSpeckVoxels) +
                        " voxels that touch nothing else dropped (the mesher would drop them)");
+    if (dropped.crumbs > 0)
+        context.warn(
+            std::to_string(dropped.crumbs) + " island(s) of the wall under " +
+            formatNumber(minPieceVolumeMm3, 4) + " mm³ that touch no other piece left out (" +
+            formatNumber(double(dropped.crumbVoxels) * voxelVolume, 4) +
+            " mm³ in all): too small for a tenon, with no face to glue them onto, nothing could hold them");
+    if (dropped.speckVoxels + dropped.crumbVoxels > 0) {
         comps = findComponents(field);
         contacts = componentContacts(field);
     }
@@ -430,6 +458,7 @@ Grouping groupPieces(VoxelField& field, const GridCells& cells, const std::vecto
     context.progress("pieces", 0.15);
     context.throwIfCancelled();
     Grouping out;
+    out.isolatedSlivers = dropped.crumbs;
     out.outsideCellsVolumeMm3 =
         assignGroups(comps, field, requests, cells.count(), gridToFrame, growMm, voxelVolume);
     Merger merger(comps, contacts, requests.size(), voxelVolume);

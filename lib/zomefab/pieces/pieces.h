@@ -182,7 +182,8 @@ struct Pieces {
     /// Shell volume in cells no request names (no outer surface there): merged into neighbours.
     double outsideCellsVolumeMm3 = 0.0;
     size_t sliversMerged = 0;
-    size_t isolatedSlivers = 0;  ///< small pieces with no neighbour to merge into (kept)
+    size_t isolatedSlivers =
+        0;  ///< islands of the wall under the smallest piece, touching no other piece: left out
     /// Pieces cut in two because the frame was in the way of every direction (docs/mounting.md):
     /// each adds one piece to what the partition asked for.
     size_t recutPieces = 0;
