@@ -148,9 +148,8 @@ size_t glueStuck(Bodies& bodies, const Disassembly& parts, const PlannerInput& i
         return std::find(list.begin(), list.end(), other) != list.end();
     };
     auto hasStave = [&](const MountBody& body) {
-        return std::any_of(body.pieces.begin(), body.pieces.end(), [&](uint32_t p) {
-            return p < input.staves.size() && input.staves[p].has_value();
-        });
+        return std::any_of(body.pieces.begin(), body.pieces.end(),
+                           [&](uint32_t p) { return input.isStave(p); });
     };
     std::vector<std::tuple<int, size_t, uint32_t, uint32_t>> pairs;  // (−kind, −contact, a, b)
     for (size_t i = 0; i < parts.stuck.size(); ++i)
@@ -486,10 +485,9 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
     std::vector<uint32_t> bodyOf(input.pieces.size());
     std::vector<std::vector<uint32_t>> members(input.pieces.size());
     for (uint32_t p = 0; p < input.pieces.size(); ++p) bodyOf[p] = p, members[p] = {p};
-    auto isStave = [&](uint32_t p) { return p < input.staves.size() && input.staves[p].has_value(); };
     for (const auto& [a, b] : input.preGlued) {
         const uint32_t ba = bodyOf[a], bb = bodyOf[b];
-        if (ba == bb || isStave(a) || isStave(b)) continue;
+        if (ba == bb || input.isStave(a) || input.isStave(b)) continue;
         MountBody sideA, sideB;
         sideA.pieces = members[ba], sideB.pieces = members[bb];
         bodies.glued.push_back(gluePair(sideA, sideB, faces));
@@ -500,7 +498,7 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
     std::vector<uint32_t> staves;
     for (uint32_t p = 0; p < input.pieces.size(); ++p) {
         if (members[p].empty()) continue;
-        if (isStave(p)) {
+        if (input.isStave(p)) {
             staves.push_back(p);
             continue;
         }

@@ -182,8 +182,9 @@ struct Pieces {
     /// Shell volume in cells no request names (no outer surface there): merged into neighbours.
     double outsideCellsVolumeMm3 = 0.0;
     size_t sliversMerged = 0;
-    size_t isolatedSlivers =
-        0;  ///< islands of the wall under the smallest piece, touching no other piece: left out
+    /// Islands of the wall under the smallest piece that touch no other piece: left out (the
+    /// largest island is kept, and counted, when the smallest piece is larger than the shell).
+    size_t isolatedSlivers = 0;
     /// Pieces cut in two because the frame was in the way of every direction (docs/mounting.md):
     /// each adds one piece to what the partition asked for.
     size_t recutPieces = 0;

@@ -220,21 +220,37 @@ bool isStaveDirection(const Stave& stave, const Vec3d& d) {
            dot(d, stave.slideGrid) >= -sinSlack && std::abs(dot(d, across)) <= sinSlack;
 }
 
+namespace {
+
+/// The way a lining of @p prism whose voxels' centres (grid mm) have the mean @p meanMm slides out
+/// along its tunnel (grid, unit): toward the mouth on its side of the tunnel's split.
+Vec3d slideOutOf(const TunnelPrism& prism, const Vec3d& meanMm) {
+    Vec3d way{0, 0, 0};
+    way[size_t(prism.axis)] = meanMm[size_t(prism.axis)] >= prism.splitMm() ? 1.0 : -1.0;
+    return way;
+}
+
+Vec3d meanOf(const std::vector<Vec3d>& pointsMm) {
+    Vec3d mean{0, 0, 0};
+    for (const Vec3d& x : pointsMm) mean = add(mean, x);
+    return scale(mean, 1.0 / double(pointsMm.size()));
+}
+
+}  // namespace
+
 std::optional<Stave> staveOf(const CellSet& set, const std::vector<Vec3d>& voxelsMm) {
     if (!isStaveSet(set) || voxelsMm.empty()) return std::nullopt;
     const TunnelPrism* prism = ownPrism(set);
     const int a = prism->axis;
     const std::array<Vec3d, 4> lifts = staveLifts(a, set.isStaveTurned);
-    Vec3d mean{0, 0, 0};
-    for (const Vec3d& x : voxelsMm) mean = add(mean, x);
-    mean = scale(mean, 1.0 / double(voxelsMm.size()));
+    const Vec3d mean = meanOf(voxelsMm);
     const Vec3d r = sub(mean, prism->axisPointMm());
     const double du = dot(r, lifts[0]), dv = dot(r, lifts[2]);
-    const double slide = mean[size_t(a)] >= prism->splitMm() ? 1.0 : -1.0;
     const bool isSide = std::abs(du) >= std::abs(dv);
     const double lift = (isSide ? du : dv) >= 0 ? 1.0 : -1.0;
     Stave st;
-    st.slideGrid[size_t(a)] = slide;
+    st.slideGrid = slideOutOf(*prism, mean);
+    const double slide = st.slideGrid[size_t(a)];
     st.liftGrid = scale(lifts[isSide ? 0 : 2], lift);
     st.seamGrid = lifts[0];
     st.isSide = isSide;
@@ -245,12 +261,7 @@ std::optional<Stave> staveOf(const CellSet& set, const std::vector<Vec3d>& voxel
 
 std::optional<Vec3d> mouthRingSlide(const CellSet& set, const std::vector<Vec3d>& voxelsMm) {
     if (!set.isMouthRing || !isStavedLining(set) || voxelsMm.empty()) return std::nullopt;
-    const TunnelPrism* prism = ownPrism(set);
-    double mean = 0.0;
-    for (const Vec3d& x : voxelsMm) mean += x[size_t(prism->axis)];
-    Vec3d way{0, 0, 0};
-    way[size_t(prism->axis)] = mean / double(voxelsMm.size()) >= prism->splitMm() ? 1.0 : -1.0;
-    return way;
+    return slideOutOf(*ownPrism(set), meanOf(voxelsMm));
 }
 
 void setStaveLifts(Pieces& out, const std::vector<CellSet>& sets, const VoxelField& field,

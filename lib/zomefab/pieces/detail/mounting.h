@@ -139,6 +139,8 @@ struct PlannerInput {
     /// on by then (a mouth ring at its deep end). Off: such a stave leaves the plan at once, placed
     /// nowhere, so that the frame grows toward it first (growFrameForStaves).
     bool isGluingUnheldStaves = false;
+    /// Whether piece @p p is a stave (staves).
+    bool isStave(uint32_t p) const { return p < staves.size() && staves[p].has_value(); }
 };
 PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
                           const std::vector<TenonCandidate>& candidates);
