@@ -202,6 +202,56 @@ TEST_CASE("mounting: a mouth ring slid into its mouth is glued on across a face 
     CHECK(disassembleAll({a, c}, faces).holes[1] == -1);
 }
 
+TEST_CASE("mounting: a ring of staves in a body's only way goes on after it, when its way out is free") {
+    // A (piece 0) can only leave upward, through stave S (piece 1) above it; S, fixed, slides out of
+    // its tunnel along +x. Staves in place throughout leave A stuck; with S's ring taken away where
+    // nothing else can leave, A goes on first, then S.
+    MountBody a = slab(0, 0, 10, 0, 5), st = slab(1, 0, 10, 20, 25);
+    a.options = {option(kUp, 2)};
+    SweepCache cache;
+    auto run = [&](const FixedStaves* staves) {
+        return disassemble({a, st}, {}, Transform4d::identity(), 1.0, GlueOnRule{}, cache,
+                           RunContext::silent(), 1, staves);
+    };
+    CHECK(run(nullptr).stuck == std::vector<uint32_t>{0});
+    const FixedStaves staves{{0}, {{1, 0, 0}}, {{}}};
+    const Disassembly d = run(&staves);
+    CHECK(d.stuck.empty());
+    CHECK(d.ringsTakenAway == 1);
+    CHECK(d.order == std::vector<uint32_t>{0, 1});
+    CHECK(d.holes[0] == kUp);
+    CHECK(std::count(d.before.begin(), d.before.end(), std::make_pair(uint32_t(0), uint32_t(1))) == 1);
+    // S sliding out downward would run into A: it stays, and A is stuck.
+    const FixedStaves down{{0}, {{0, 0, -1}}, {{}}};
+    const Disassembly e = run(&down);
+    CHECK(e.stuck == std::vector<uint32_t>{0});
+    CHECK(e.ringsTakenAway == 0);
+    // A ring no body left needs out of the way stays first.
+    a.options = {option(zome::nearestHole({-1, 0, 0}), 2)};
+    const Disassembly f = run(&staves);
+    CHECK(f.stuck.empty());
+    CHECK(f.ringsTakenAway == 0);
+    CHECK(f.order == std::vector<uint32_t>{1, 0});
+}
+
+TEST_CASE("mounting: a ring of staves another stave is glued in place onto stays while that one is on") {
+    // A leaves only upward through stave S (ring 0); stave T (ring 1, beside S) is glued in place
+    // onto S, and T's way out (+x) runs into A. S may not go while T is on, T not while A is: stuck.
+    MountBody a = slab(0, 0, 10, 0, 5), s = slab(1, 0, 10, 20, 25), t = slab(2, -20, -10, 0, 5);
+    a.options = {option(kUp, 2)};
+    SweepCache cache;
+    const FixedStaves staves{{0, 1}, {{1, 0, 0}, {1, 0, 0}}, {{}, {0}}};
+    const Disassembly d = disassemble({a, s, t}, {}, Transform4d::identity(), 1.0, GlueOnRule{}, cache,
+                                      RunContext::silent(), 2, &staves);
+    CHECK(d.stuck == std::vector<uint32_t>{0});
+    // Not glued onto S, T stays in place and S goes after A.
+    const FixedStaves apart{{0, 1}, {{1, 0, 0}, {1, 0, 0}}, {{}, {}}};
+    const Disassembly e = disassemble({a, s, t}, {}, Transform4d::identity(), 1.0, GlueOnRule{}, cache,
+                                      RunContext::silent(), 2, &apart);
+    CHECK(e.stuck.empty());
+    CHECK(e.order == std::vector<uint32_t>{2, 0, 1});
+}
+
 TEST_CASE("mounting: a piece glued on goes on before its only host leaves") {
     // A holds; C sits on A, D beside C (across x = 10.5). Neither C nor D has pegs: D can only be
     // glued onto C, so C must not be taken away first, though it comes first by index.

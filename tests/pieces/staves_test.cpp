@@ -398,6 +398,43 @@ TEST_CASE("orderStaveRings: a ring's staves glued round the ring count as held; 
     CHECK(orderStaveRings(g) == std::vector<size_t>{3, 0, 1, 2});
 }
 
+TEST_CASE("addStaveSteps: staves go on among the other steps where the disassembly put them") {
+    // Staves 0 (held, slid in and lifted) and 1 (glued in place onto 0); the plan's own steps are
+    // pieces 5 and 6. Slots: stave 0 first, then piece 5, stave 1, piece 6.
+    PlannerInput input = stavesAlongX(7, [](uint32_t) { return std::make_tuple(-10.0, true, 1.0); });
+    mount::InstallationPlan plan;
+    plan.steps = {{{5}, 3}, {{6}, 4}};
+    const StaveOrder order{{0, 1}, {7, 8}, {{}, {0}}};
+    addStaveSteps(plan, input, order, Transform4d::identity(), {{0, 0}, {1, 1}});
+    REQUIRE(plan.steps.size() == 4);
+    CHECK(plan.steps[0].pieces == std::vector<uint32_t>{0});
+    CHECK(plan.steps[0].hasTwoLegs());
+    CHECK(plan.steps[1].pieces == std::vector<uint32_t>{5});
+    CHECK(plan.steps[2].pieces == std::vector<uint32_t>{1});
+    CHECK_FALSE(plan.steps[2].hasTwoLegs());
+    CHECK(plan.steps[3].pieces == std::vector<uint32_t>{6});
+    CHECK(plan.gluedOn == std::vector<std::pair<uint32_t, uint32_t>>{{0, 1}});
+    // No slots: every stave first, in the order's order.
+    mount::InstallationPlan first;
+    first.steps = {{{5}, 3}};
+    addStaveSteps(first, input, order, Transform4d::identity());
+    REQUIRE(first.steps.size() == 3);
+    CHECK(first.steps[0].pieces == std::vector<uint32_t>{0});
+    CHECK(first.steps[1].pieces == std::vector<uint32_t>{1});
+    CHECK(first.steps[2].pieces == std::vector<uint32_t>{5});
+}
+
+TEST_CASE("fixedStaves: a ring is a run of staves of one ring, hosts by their index") {
+    const PlannerInput input = stavesAlongX(
+        3, [](uint32_t p) { return std::make_tuple(p < 2 ? -20.0 : -10.0, p != 1, p == 0 ? 1.0 : -1.0); });
+    const StaveOrder order{{0, 1, 2}, {7, 7, 8}, {{}, {}, {0}}};
+    const FixedStaves f = fixedStaves(order, input);
+    CHECK(f.ringOf == std::vector<size_t>{0, 0, 1});
+    CHECK(f.hosts == std::vector<std::vector<size_t>>{{}, {}, {0}});
+    REQUIRE(f.slideGrid.size() == 3);
+    CHECK(f.slideGrid[2][0] == 1.0);
+}
+
 TEST_CASE("staveRings: a stave in another's way out along its tunnel puts that one's ring later") {
     // A tunnel along x whose staves slide out toward +x: stave 0 deep (x 0-10), stave 1 shallower
     // in the same columns (x 20-30), stave 2 shallower still but beside them (y 20-30).

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Who goes on first: whether a body can go on after another along a direction, the disassembly
-// that finds the mounting order and each body's direction, and the glued bodies where none exists
-// (detail/mounting.h, docs/mounting.md, "Order" and "Glued groups").
+// Who goes on first: whether a body can go on after another along a direction, and the disassembly
+// that finds the mounting order and each body's direction, rings of staves taken away where nothing
+// else can leave (detail/mounting.h, docs/mounting.md, "Order"; mounting_plan.cpp plans with it).
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -84,178 +84,6 @@ bool facesAllow(const MountBody& still, const MountBody& moving, const Vec3d& d,
     return isOk;
 }
 
-namespace {
-
-/// The body names and a list of pieces for messages: "piece 3", "pieces 3 + 4 (glued)".
-std::string bodyName(const MountBody& b) {
-    if (b.pieces.size() == 1) return "piece " + std::to_string(b.pieces[0]);
-    std::string list;
-    for (uint32_t p : b.pieces) list += (list.empty() ? "" : " + ") + std::to_string(p);
-    return "pieces " + list + " (glued)";
-}
-
-/// The pair of pieces, one of each body, with the largest common cut face: where they are glued.
-std::pair<uint32_t, uint32_t> gluePair(const MountBody& a, const MountBody& b, const FaceContacts& faces) {
-    std::pair<uint32_t, uint32_t> best{a.pieces[0], b.pieces[0]};
-    size_t bestCount = 0;
-    for (uint32_t x : a.pieces)
-        for (uint32_t y : b.pieces) {
-            const auto it = faces.find({std::min(x, y), std::max(x, y)});
-            if (it == faces.end()) continue;
-            size_t count = 0;
-            for (const CutContact& c : it->second) count += c.voxelFaces;
-            if (count > bestCount) bestCount = count, best = {std::min(x, y), std::max(x, y)};
-        }
-    return best;
-}
-
-/// The planner's state: the bodies and the pieces glued so far.
-struct Bodies {
-    std::vector<MountBody> list;
-    std::vector<std::pair<uint32_t, uint32_t>> glued;
-
-    /// Replaces each pair of bodies (i, j, joined) of @p joins (no body in two) by its joined body,
-    /// kept at the lower index; the higher ones are removed.
-    void glue(std::vector<std::tuple<uint32_t, uint32_t, MountBody>>&& joins, const FaceContacts& faces) {
-        std::vector<uint8_t> isGone(list.size(), 0);
-        for (auto& [i, j, joined] : joins) {
-            glued.push_back(gluePair(list[i], list[j], faces));
-            list[std::min(i, j)] = std::move(joined);
-            isGone[std::max(i, j)] = 1;
-        }
-        size_t kept = 0;
-        for (size_t k = 0; k < list.size(); ++k) {
-            if (isGone[k]) continue;
-            if (kept != k) list[kept] = std::move(list[k]);  // a self-move would empty it
-            ++kept;
-        }
-        list.resize(kept);
-    }
-};
-
-/// Glues pairs of touching bodies, one of them stuck, whose union has a free direction with
-/// tenons: two stuck ones in each other's way first, then two stuck ones, then a stuck one and a
-/// neighbour (a piece to be glued on that its only host is in the way of), each by the largest
-/// contact. Every pair of the best kind that succeeds is glued in one call, each body at most once
-/// (one pair per call took a planning round per pair: the cheese at 700 mm had 135 stuck bodies and
-/// a round of 20 s). @p noFreeUnion remembers the unions found with no free direction. Returns how
-/// many pairs were glued.
-size_t glueStuck(Bodies& bodies, const Disassembly& parts, const PlannerInput& input,
-                 const FrameSweeps& sweeps, const FaceContacts& faces, double voxelMm, int maxPerPiece,
-                 std::set<std::vector<uint32_t>>& noFreeUnion, size_t fixedCount) {
-    auto blocks = [&](size_t k, uint32_t other) {
-        const std::vector<uint32_t>& list = parts.stuckBlockers[k];
-        return std::find(list.begin(), list.end(), other) != list.end();
-    };
-    auto hasStave = [&](const MountBody& body) {
-        return std::any_of(body.pieces.begin(), body.pieces.end(),
-                           [&](uint32_t p) { return input.isStave(p); });
-    };
-    std::vector<std::tuple<int, size_t, uint32_t, uint32_t>> pairs;  // (−kind, −contact, a, b)
-    for (size_t i = 0; i < parts.stuck.size(); ++i)
-        for (uint32_t b = 0; b + fixedCount < bodies.list.size(); ++b) {
-            const uint32_t a = parts.stuck[i];
-            const auto other = std::find(parts.stuck.begin(), parts.stuck.end(), b);
-            if (b == a || (other != parts.stuck.end() && b < a)) continue;  // each stuck pair once
-            if (hasStave(bodies.list[a]) || hasStave(bodies.list[b])) continue;  // never glued into groups
-            const size_t contact = bodyContact(bodies.list[a], bodies.list[b], faces);
-            if (contact == 0) continue;
-            int kind = 0;
-            if (other != parts.stuck.end()) {
-                const size_t j = size_t(other - parts.stuck.begin());
-                kind = 1 + (blocks(i, b) ? 1 : 0) + (blocks(j, a) ? 1 : 0);
-            }
-            pairs.push_back({-kind, size_t(0) - contact, a, b});
-        }
-    std::sort(pairs.begin(), pairs.end());
-    std::vector<uint8_t> isUsed(bodies.list.size(), 0);
-    std::vector<std::tuple<uint32_t, uint32_t, MountBody>> joins;
-    std::optional<int> gluedKind;
-    for (const auto& [negKind, contact, a, b] : pairs) {
-        if (gluedKind && negKind != *gluedKind) break;
-        if (isUsed[a] || isUsed[b]) continue;
-        if (bodies.list[a].pieces.size() + bodies.list[b].pieces.size() > kMaxGluedPieces) continue;
-        std::vector<uint32_t> members = bodies.list[a].pieces;
-        members.insert(members.end(), bodies.list[b].pieces.begin(), bodies.list[b].pieces.end());
-        std::sort(members.begin(), members.end());
-        if (noFreeUnion.count(members)) continue;
-        MountBody u = makeBody(members, input, sweeps, voxelMm, maxPerPiece, 1);
-        if (!u.bestFree()) {
-            noFreeUnion.insert(members);
-            continue;
-        }
-        testPaths(u, sweeps, voxelMm);
-        isUsed[a] = isUsed[b] = 1;
-        gluedKind = negKind;
-        joins.emplace_back(a, b, std::move(u));
-    }
-    const size_t count = joins.size();
-    bodies.glue(std::move(joins), faces);
-    return count;
-}
-
-/// The plan of @p parts; the last @p fixedCount bodies are staves, whose problems are the caller's.
-mount::InstallationPlan writePlan(const Bodies& bodies, const Disassembly& parts, size_t pieceCount,
-                                  size_t fixedCount) {
-    mount::InstallationPlan plan;
-    plan.holeOfPiece.assign(pieceCount, -1);
-    plan.groupOf.assign(pieceCount, 0);
-    plan.glued = bodies.glued;
-    std::sort(plan.glued.begin(), plan.glued.end());
-    for (size_t b = 0; b < bodies.list.size(); ++b)
-        for (uint32_t p : bodies.list[b].pieces) {
-            plan.holeOfPiece[p] = parts.holes[b];
-            plan.groupOf[p] = bodies.list[b].pieces[0];
-        }
-    for (const auto& [a, b] : parts.before)
-        plan.before.push_back({bodies.list[a].pieces[0], bodies.list[b].pieces[0]});
-    plan.gluedOn = parts.gluedOn;
-    for (size_t b = 0; b + fixedCount < bodies.list.size(); ++b) {
-        const MountBody& body = bodies.list[b];
-        if (parts.holes[b] >= 0 || std::count(parts.stuck.begin(), parts.stuck.end(), uint32_t(b))) continue;
-        std::string why = body.options.empty() ? "no ball's hole points at it within a tenon's reach"
-                                               : "every direction with tenons is blocked (" +
-                                                     body.options[0].blockedBy + " in the way of the best)";
-        const bool isFreeAlong = std::any_of(body.glueOptions.begin(), body.glueOptions.end(),
-                                             [](const DirectionOption& o) { return o.isFree; });
-        why += isFreeAlong ? ", and it shares no cut face large enough to glue it onto a neighbour"
-                           : ", and the frame is in the way of every direction to glue it on along";
-        plan.problems.push_back(bodyName(body) + ": no direction to push it on along and hold it: " + why);
-    }
-    if (!parts.stuck.empty()) {
-        std::string list, detail;
-        // Named up to kNamed (the cheese at 700 mm has over a hundred: one line must stay readable).
-        constexpr size_t kNamed = 6;
-        const size_t stuckCount = parts.stuck.size();
-        for (size_t k = 0; k < stuckCount; ++k) {
-            const uint32_t b = parts.stuck[k];
-            if (k < kNamed)
-                list += (k == 0 ? "" : k + 1 == stuckCount ? " and " : ", ") + bodyName(bodies.list[b]);
-            else if (k == kNamed)
-                list += " and " + std::to_string(stuckCount - kNamed) + " more bodies";
-            if (k >= 3) continue;
-            if (parts.stuckBlockers[k].empty()) {
-                detail += (detail.empty() ? "" : "; ") + bodyName(bodies.list[b]) +
-                          ": no piece to glue it onto is on when its path is free";
-                continue;
-            }
-            std::string in;
-            for (uint32_t o : parts.stuckBlockers[k])
-                in += (in.empty() ? "" : ", ") + bodyName(bodies.list[o]);
-            detail +=
-                (detail.empty() ? "" : "; ") + bodyName(bodies.list[b]) + " along its best direction: " + in;
-        }
-        plan.problems.push_back(
-            list + " cannot be put on in any order: each one's path or cut faces meet another of them (" +
-            detail + ")");
-    }
-    if (parts.stuck.empty())
-        for (uint32_t b : parts.order) plan.steps.push_back({bodies.list[b].pieces, parts.holes[b]});
-    return plan;
-}
-
-}  // namespace
-
 size_t bodyContact(const MountBody& a, const MountBody& b, const FaceContacts& faces) {
     size_t count = 0;
     for (uint32_t x : a.pieces)
@@ -304,15 +132,12 @@ std::vector<Usable> usableOf(const MountBody& body, bool hasHosts) {
     return list;
 }
 
-/// The bodies that keep @p b from going on after them along usable direction @p k (computed once;
-/// the sweeps in parallel).
-const std::vector<uint32_t>& blockersOf(std::vector<BodyState>& state, uint32_t b, size_t k,
-                                        const std::vector<MountBody>& bodies, const FaceContacts& faces,
-                                        const Transform4d& frameToGridMm, double voxelMm, SweepCache& cache) {
-    std::optional<std::vector<uint32_t>>& slot = state[b].blockers[k];
-    if (slot) return *slot;
-    const int hole = holeOf(bodies, state, b, k);
-    const Vec3d d = gridDirection(hole, frameToGridMm);
+/// The bodies that keep @p b from going on after them along @p d (grid, unit), remembered in
+/// @p cache under @p key (its hole; −1: a stave's slide); the sweeps in parallel.
+std::vector<uint32_t> wayBlockers(const std::vector<BodyState>& state, uint32_t b, const Vec3d& d, int key,
+                                  const std::vector<MountBody>& bodies, const FaceContacts& faces,
+                                  double voxelMm, SweepCache& cache) {
+    const int hole = key;
     const size_t n = bodies.size();
     // Faces and cached sweeps first; the sweeps still to make run in parallel.
     std::vector<int8_t> isBlocked(n, 0);
@@ -342,9 +167,21 @@ const std::vector<uint32_t>& blockersOf(std::vector<BodyState>& state, uint32_t 
         cache[std::make_tuple(bodies[b].pieces, bodies[toSweep[i]].pieces, hole)] = hits[i];
         isBlocked[toSweep[i]] = int8_t(hits[i]);
     }
-    slot.emplace();
+    std::vector<uint32_t> list;
     for (uint32_t a = 0; a < n; ++a)
-        if (isBlocked[a]) slot->push_back(a);
+        if (isBlocked[a]) list.push_back(a);
+    return list;
+}
+
+/// The bodies that keep @p b from going on after them along usable direction @p k (computed once).
+const std::vector<uint32_t>& blockersOf(std::vector<BodyState>& state, uint32_t b, size_t k,
+                                        const std::vector<MountBody>& bodies, const FaceContacts& faces,
+                                        const Transform4d& frameToGridMm, double voxelMm, SweepCache& cache) {
+    std::optional<std::vector<uint32_t>>& slot = state[b].blockers[k];
+    if (!slot) {
+        const int hole = holeOf(bodies, state, b, k);
+        slot = wayBlockers(state, b, gridDirection(hole, frameToGridMm), hole, bodies, faces, voxelMm, cache);
+    }
     return *slot;
 }
 
@@ -373,11 +210,129 @@ std::vector<HostFace> hostFaces(const std::vector<MountBody>& bodies, uint32_t b
     return out;
 }
 
+/// The staves' ways out and the ring to take away where no other body can leave (disassemble).
+struct RingPicker {
+    const std::vector<MountBody>& bodies;
+    const std::vector<BodyState>& state;
+    const std::vector<uint8_t>& isLeft;
+    const std::vector<std::vector<HostFace>>& hosts;
+    const FixedStaves& staves;
+    const FaceContacts& faces;
+    double voxelMm;
+    SweepCache& cache;
+    std::vector<std::optional<std::vector<uint32_t>>> ways{staves.ringOf.size()};  ///< per stave
+
+    size_t first() const { return bodies.size() - staves.ringOf.size(); }
+    /// Body @p a's ring, SIZE_MAX for a body that is no stave.
+    size_t ringOf(uint32_t a) const { return a >= first() ? staves.ringOf[a - first()] : SIZE_MAX; }
+    /// The bodies in stave @p k's way out along its tunnel (computed once).
+    const std::vector<uint32_t>& wayOf(size_t k) {
+        if (!ways[k])
+            ways[k] = wayBlockers(state, uint32_t(first() + k), staves.slideGrid[k], -1, bodies, faces,
+                                  voxelMm, cache);
+        return *ways[k];
+    }
+    /// Whether every stave of ring @p r left can slide out past the bodies left but its ring.
+    bool isFree(size_t r) {
+        for (size_t k = 0; k < staves.ringOf.size(); ++k) {
+            if (staves.ringOf[k] != r || !isLeft[first() + k]) continue;
+            for (uint32_t a : wayOf(k))
+                if (isLeft[a] && ringOf(a) != r) return false;
+        }
+        return true;
+    }
+    /// Rings that must stay: a stave glued in place onto one of theirs is left, or a body left to be
+    /// glued on has only their staves left to be glued onto.
+    std::vector<uint8_t> mustStay(size_t ringCount) const {
+        std::vector<uint8_t> stay(ringCount, 0);
+        for (size_t k = 0; k < staves.ringOf.size(); ++k)
+            if (isLeft[first() + k])
+                for (size_t j : staves.hosts[k])
+                    if (staves.ringOf[j] != staves.ringOf[k]) stay[staves.ringOf[j]] = 1;
+        for (uint32_t b = 0; b < first(); ++b) {
+            if (!isLeft[b] || !state[b].canGlue()) continue;
+            size_t ring = SIZE_MAX;
+            bool isOther = false;
+            for (const HostFace& h : hosts[b]) {
+                if (!isLeft[h.body]) continue;
+                const size_t r = ringOf(h.body);
+                isOther = isOther || r == SIZE_MAX || (ring != SIZE_MAX && r != ring);
+                ring = r;
+            }
+            if (!isOther && ring != SIZE_MAX) stay[ring] = 1;
+        }
+        return stay;
+    }
+    /// Rings in the way of a body left (as far as its ways were asked for), of a stave of such a
+    /// ring, or glued in place onto one.
+    std::vector<uint8_t> wanted(size_t ringCount) {
+        std::vector<uint8_t> want(ringCount, 0);
+        for (uint32_t b = 0; b < first(); ++b)
+            if (isLeft[b])
+                for (const auto& slot : state[b].blockers)
+                    if (slot)
+                        for (uint32_t a : *slot)
+                            if (isLeft[a] && ringOf(a) != SIZE_MAX) want[ringOf(a)] = 1;
+        for (bool isGrown = true; isGrown;) {
+            isGrown = false;
+            for (size_t k = 0; k < staves.ringOf.size(); ++k) {
+                if (!isLeft[first() + k]) continue;
+                const size_t r = staves.ringOf[k];
+                for (size_t j : staves.hosts[k])
+                    if (want[staves.ringOf[j]] && !want[r]) want[r] = 1, isGrown = true;
+                if (!want[r]) continue;
+                for (uint32_t a : wayOf(k))
+                    if (isLeft[a] && ringOf(a) != SIZE_MAX && !want[ringOf(a)])
+                        want[ringOf(a)] = 1, isGrown = true;
+            }
+        }
+        return want;
+    }
+    /// The last ring in the staves' order that may be taken away now and is wanted, or none.
+    std::optional<size_t> pick() {
+        if (staves.ringOf.empty()) return std::nullopt;
+        const size_t ringCount = staves.ringOf.back() + 1;
+        std::vector<uint8_t> isIn(ringCount, 0);
+        for (size_t k = 0; k < staves.ringOf.size(); ++k)
+            if (isLeft[first() + k]) isIn[staves.ringOf[k]] = 1;
+        const std::vector<uint8_t> stay = mustStay(ringCount), want = wanted(ringCount);
+        for (size_t r = ringCount; r-- > 0;)
+            if (isIn[r] && !stay[r] && want[r] && isFree(r)) return r;
+        return std::nullopt;
+    }
+    /// For the debug output once the bodies left are stuck: why each ring in their way stays.
+    std::vector<std::string> notes() {
+        std::vector<std::string> out;
+        if (staves.ringOf.empty()) return out;
+        const size_t ringCount = staves.ringOf.back() + 1;
+        const std::vector<uint8_t> stay = mustStay(ringCount), want = wanted(ringCount);
+        for (size_t r = 0; r < ringCount; ++r) {
+            if (!want[r]) continue;
+            std::string note, staveList;
+            for (size_t k = 0; k < staves.ringOf.size(); ++k) {
+                if (staves.ringOf[k] != r || !isLeft[first() + k]) continue;
+                const uint32_t p = bodies[first() + k].pieces[0];
+                staveList += " " + std::to_string(p);
+                std::string in;
+                for (uint32_t a : wayOf(k))
+                    if (isLeft[a] && ringOf(a) != r)
+                        in += " " + std::to_string(bodies[a].pieces[0]) + (ringOf(a) == SIZE_MAX ? "" : "s");
+                if (!in.empty()) note += "; stave " + std::to_string(p) + "'s way meets" + in;
+            }
+            if (staveList.empty()) continue;
+            out.push_back("ring of staves" + staveList +
+                          (stay[r] ? " stays for a stave or body glued onto it" : "") + note);
+        }
+        return out;
+    }
+};
+
 }  // namespace
 
 Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts& faces,
                         const Transform4d& frameToGridMm, double voxelMm, const GlueOnRule& glueOn,
-                        SweepCache& cache, const RunContext& context, size_t fixedCount) {
+                        SweepCache& cache, const RunContext& context, size_t fixedCount,
+                        const FixedStaves* staves) {
     const size_t n = bodies.size();
     std::vector<BodyState> state(n);
     std::vector<std::vector<HostFace>> hosts(n);
@@ -398,6 +353,8 @@ Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts
     out.holes.assign(n, -1);
     std::vector<size_t> chosen(n, SIZE_MAX);
     std::vector<uint32_t> removed;
+    std::optional<RingPicker> rings;
+    if (staves) rings.emplace(RingPicker{bodies, state, isLeft, hosts, *staves, faces, voxelMm, cache});
     auto isClear = [&](const std::vector<uint32_t>& blockers) {
         return std::all_of(blockers.begin(), blockers.end(), [&](uint32_t a) { return !isLeft[a]; });
     };
@@ -445,7 +402,16 @@ Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts
                 break;
             }
         }
-        if (!best) break;
+        if (!best) {
+            // Nothing else can leave: a ring of staves may, its staves the last first (docs above).
+            const std::optional<size_t> ring = staves ? rings->pick() : std::nullopt;
+            if (!ring) break;
+            for (size_t k = fixedCount; k-- > 0;)
+                if (staves->ringOf[k] == *ring && isLeft[n - fixedCount + k])
+                    removed.push_back(uint32_t(n - fixedCount + k)), isLeft[n - fixedCount + k] = 0;
+            ++out.ringsTakenAway;
+            continue;
+        }
         const auto [kind, k, negLow, b] = *best;
         if (state[b].usable[k].isGlue)
             for (const HostFace* h : gluable(b, k)) {
@@ -457,9 +423,14 @@ Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts
         removed.push_back(b);
         isLeft[b] = 0, --left;
     }
-    out.order.assign(removed.rbegin(), removed.rend());
+    for (uint32_t b = uint32_t(n - fixedCount); b < n; ++b)
+        if (isLeft[b]) out.order.push_back(b);  // staves left in place: first, in their order
+    out.order.insert(out.order.end(), removed.rbegin(), removed.rend());
+    if (rings && left > 0) out.ringNotes = rings->notes();
     for (uint32_t b = 0; b < n; ++b) {
-        if (chosen[b] != SIZE_MAX) {
+        if (b + fixedCount >= n && !isLeft[b]) {  // a stave taken away: after what its way meets
+            for (uint32_t a : *rings->ways[b + fixedCount - n]) out.before.push_back({b, a});
+        } else if (chosen[b] != SIZE_MAX) {
             for (uint32_t a : *state[b].blockers[chosen[b]]) out.before.push_back({b, a});
         } else if (isLeft[b] && !state[b].isFixed) {
             out.stuck.push_back(b);
@@ -474,101 +445,6 @@ Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts
     std::sort(out.gluedOn.begin(), out.gluedOn.end());
     out.gluedOn.erase(std::unique(out.gluedOn.begin(), out.gluedOn.end()), out.gluedOn.end());
     return out;
-}
-
-mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweeps& sweeps,
-                                     const FaceContacts& faces, double voxelMm, const std::vector<int>& holes,
-                                     int maxPerPiece, const RunContext& context) {
-    Bodies bodies;
-    // Pieces glued before planning start as one body: each pair joins the bodies of its pieces,
-    // glued across the largest face between the two sides.
-    std::vector<uint32_t> bodyOf(input.pieces.size());
-    std::vector<std::vector<uint32_t>> members(input.pieces.size());
-    for (uint32_t p = 0; p < input.pieces.size(); ++p) bodyOf[p] = p, members[p] = {p};
-    for (const auto& [a, b] : input.preGlued) {
-        const uint32_t ba = bodyOf[a], bb = bodyOf[b];
-        if (ba == bb || input.isStave(a) || input.isStave(b)) continue;
-        MountBody sideA, sideB;
-        sideA.pieces = members[ba], sideB.pieces = members[bb];
-        bodies.glued.push_back(gluePair(sideA, sideB, faces));
-        for (uint32_t p : members[bb]) bodyOf[p] = ba;
-        members[ba].insert(members[ba].end(), members[bb].begin(), members[bb].end());
-        members[bb].clear();
-    }
-    std::vector<uint32_t> staves;
-    for (uint32_t p = 0; p < input.pieces.size(); ++p) {
-        if (members[p].empty()) continue;
-        if (input.isStave(p)) {
-            staves.push_back(p);
-            continue;
-        }
-        bodies.list.push_back(makeBody(members[p], input, sweeps, voxelMm, maxPerPiece));
-        if (bodies.list.back().isHosted()) addGlueOptions(bodies.list.back(), holes, sweeps, voxelMm);
-        context.throwIfCancelled();
-    }
-    // Staves go on first, in their order, and stay in every other body's way: the fixed bodies at
-    // the end of the list (those placed nowhere may go on with the rest, isGluingUnheldStaves).
-    StaveOrder order = placeStaves(staves, input, sweeps, faces, voxelMm, maxPerPiece, context, bodies.list);
-    const size_t fixed = order.pieces.size();
-    // A stave no hole holds and none of its ring holds it either leaves no plan to be carried out:
-    // the frame must grow toward it first (growFrameForStaves), and an order of the rest is not
-    // sought (the cheese at 700 mm: minutes).
-    if (std::count(order.holes.begin(), order.holes.end(), -1) > 0)
-        return unheldStavesPlan(input, order, sweeps.frameToGridMm());
-    SweepCache cache;
-    const GlueOnRule glueOn;
-    Disassembly parts =
-        disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context, fixed);
-    // Bodies held by pegs but stuck may be glued on instead, along a direction no peg uses.
-    if (!parts.stuck.empty()) {
-        for (uint32_t b : parts.stuck)
-            if (bodies.list[b].glueOptions.empty()) addGlueOptions(bodies.list[b], holes, sweeps, voxelMm);
-        parts =
-            disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context, fixed);
-    }
-    // Where no order exists, glue stuck bodies that are in each other's way into one (a few times:
-    // what gluing does not resolve is re-cut).
-    const size_t maxGlues = std::max<size_t>(4, input.pieces.size() / 4);
-    // Gluing that stops lowering the stuck count (no new low in kGlueStall rounds) is given up:
-    // the cheese at 700 mm went 137, 119, …, 88, 106, 104, 101, … stuck bodies over 14 rounds of
-    // 20 s, its tunnel linings in each other's way across the tunnels whatever was glued.
-    constexpr size_t kGlueStall = 3;
-    std::set<std::vector<uint32_t>> noFreeUnion;
-    size_t fewestStuck = parts.stuck.size(), stall = 0;
-    for (size_t glues = 0;
-         input.isGluingStuck && !parts.stuck.empty() && glues < maxGlues && stall < kGlueStall;) {
-        for (size_t k = 0; k < parts.stuck.size(); ++k) {
-            std::string in;
-            for (uint32_t o : parts.stuckBlockers[k]) in += " " + bodyName(bodies.list[o]);
-            // Where it is and which way it would go (grid mm; none: no peg holds it), to find it.
-            const MountBody& body = bodies.list[parts.stuck[k]];
-            const Vec3d &lo = body.bounds.min, &hi = body.bounds.max;
-            std::string d = " (no peg holds it)";
-            if (const DirectionOption* o = body.bestFree()) {
-                const Vec3d v = gridDirection(o->hole, sweeps.frameToGridMm());
-                d = formatNumbers(" along (%.2f, %.2f, %.2f)", v[0], v[1], v[2]);
-            }
-            context.debug("mounting: stuck: " + bodyName(body) +
-                          formatNumbers(" in (%.0f, %.0f, %.0f)-(%.0f, %.0f, %.0f) mm", lo[0], lo[1], lo[2],
-                                        hi[0], hi[1], hi[2]) +
-                          d + ", in its way:" + in);
-        }
-        const size_t glued =
-            glueStuck(bodies, parts, input, sweeps, faces, voxelMm, maxPerPiece, noFreeUnion, fixed);
-        if (glued == 0) break;
-        glues += glued;
-        context.debug("mounting: " + std::to_string(parts.stuck.size()) + " bodies stuck, " +
-                      std::to_string(glued) + " pairs glued into one");
-        parts =
-            disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context, fixed);
-        stall = parts.stuck.size() < fewestStuck ? 0 : stall + 1;
-        fewestStuck = std::min(fewestStuck, parts.stuck.size());
-    }
-    const size_t firstStave = bodies.list.size() - fixed;
-    for (size_t k = 0; k < fixed; ++k) parts.holes[firstStave + k] = order.holes[k];
-    mount::InstallationPlan plan = writePlan(bodies, parts, input.pieces.size(), fixed);
-    addStaveSteps(plan, input, order, sweeps.frameToGridMm());
-    return plan;
 }
 
 }  // namespace zomefab::pieces::detail

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <string>
 #include <tuple>
 
@@ -298,6 +299,23 @@ std::vector<size_t> glueStavesInPlace(StaveOrder& order, const PlannerInput& inp
     }
     order = permuted(order, perm);
     return perm;
+}
+
+FixedStaves fixedStaves(const StaveOrder& order, const PlannerInput& input) {
+    FixedStaves out;
+    std::map<uint32_t, size_t> indexOf;  // piece → its index in the order
+    for (size_t k = 0; k < order.pieces.size(); ++k) {
+        const Stave& stave = *input.staves[order.pieces[k]];
+        const bool isNewRing = k == 0 || ringKey(stave) != ringKey(*input.staves[order.pieces[k - 1]]);
+        out.ringOf.push_back(k == 0 ? 0 : out.ringOf.back() + (isNewRing ? 1 : 0));
+        out.slideGrid.push_back(stave.slideGrid);
+        indexOf[order.pieces[k]] = k;
+    }
+    out.hosts.resize(order.pieces.size());
+    for (size_t k = 0; k < order.hosts.size() && k < order.pieces.size(); ++k)
+        for (uint32_t host : order.hosts[k])
+            if (const auto it = indexOf.find(host); it != indexOf.end()) out.hosts[k].push_back(it->second);
+    return out;
 }
 
 StaveOrder permuted(const StaveOrder& order, const std::vector<size_t>& perm) {

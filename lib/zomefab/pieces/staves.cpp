@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "zomefab/core/format.h"
@@ -316,8 +317,8 @@ MountBody staveBody(uint32_t p, const PlannerInput& input, const Transform4d& fr
 }
 
 void addStaveSteps(mount::InstallationPlan& plan, const PlannerInput& input, const StaveOrder& order,
-                   const Transform4d& frameToGridMm) {
-    std::vector<mount::MountStep> steps;
+                   const Transform4d& frameToGridMm, const std::vector<std::pair<size_t, size_t>>& slots) {
+    std::vector<std::optional<mount::MountStep>> steps(order.pieces.size());  // per stave
     const Transform4d gridToFrame = affineInverse(frameToGridMm);
     for (size_t k = 0; k < order.pieces.size(); ++k) {
         const uint32_t p = order.pieces[k];
@@ -330,15 +331,27 @@ void addStaveSteps(mount::InstallationPlan& plan, const PlannerInput& input, con
         }
         if (k < order.hosts.size() && !order.hosts[k].empty()) {
             // Glued in place: slid straight along its tunnel, along the seams of its hosts.
-            steps.push_back({{p}, order.holes[k]});
+            steps[k] = mount::MountStep{{p}, order.holes[k]};
             for (uint32_t host : order.hosts[k]) plan.gluedOn.push_back({host, p});
             continue;
         }
         const Vec3d slide = normalized(applyLinear(gridToFrame, input.staves[p]->slideGrid));
-        steps.push_back({{p}, order.holes[k], slide, kStaveLiftMm});
+        steps[k] = mount::MountStep{{p}, order.holes[k], slide, kStaveLiftMm};
     }
     std::sort(plan.gluedOn.begin(), plan.gluedOn.end());
-    if (plan.isBuildable()) plan.steps.insert(plan.steps.begin(), steps.begin(), steps.end());
+    if (!plan.isBuildable()) return;
+    std::vector<std::pair<size_t, size_t>> at = slots;  // (stave, steps of the rest before it)
+    if (at.empty())
+        for (size_t k = 0; k < order.pieces.size(); ++k) at.push_back({k, 0});
+    std::vector<mount::MountStep> merged;
+    size_t next = 0;  // the rest's next step
+    for (const auto& [k, before] : at) {
+        for (; next < before && next < plan.steps.size(); ++next)
+            merged.push_back(std::move(plan.steps[next]));
+        if (steps[k]) merged.push_back(std::move(*steps[k]));
+    }
+    for (; next < plan.steps.size(); ++next) merged.push_back(std::move(plan.steps[next]));
+    plan.steps = std::move(merged);
 }
 
 mount::InstallationPlan unheldStavesPlan(const PlannerInput& input, const StaveOrder& order,

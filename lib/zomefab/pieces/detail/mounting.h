@@ -238,11 +238,24 @@ StaveOrder placeStaves(std::vector<uint32_t> staves, const PlannerInput& input, 
                        const FaceContacts& faces, double voxelMm, int maxPerPiece, const RunContext& context,
                        std::vector<MountBody>& list);
 
-/// The steps of @p order's staves put before @p plan's: each slid in along its tunnel and held
+/// The staves at the end of a disassembly's bodies (StaveOrder, in their mounting order), as the
+/// disassembly takes rings of them away.
+struct FixedStaves {
+    std::vector<size_t> ringOf;    ///< per stave: its ring, numbered in the order (a run of staves)
+    std::vector<Vec3d> slideGrid;  ///< per stave: its way out of its mouth along its tunnel (grid, unit)
+    std::vector<std::vector<size_t>> hosts;  ///< per stave: the staves (indices) it is glued in place onto
+};
+/// @p order's staves as FixedStaves: a ring is a run of staves of one ring (Stave::rank).
+FixedStaves fixedStaves(const StaveOrder& order, const PlannerInput& input);
+
+/// The steps of @p order's staves put among @p plan's: each slid in along its tunnel and held
 /// kStaveLiftMm off its place, or, glued in place, slid straight to it (its hosts glued on); a
-/// stave with no direction is a problem of the plan instead.
+/// stave with no direction is a problem of the plan instead. @p slots: per stave in its mounting
+/// order, (its index in @p order, how many of @p plan's steps go on before it); empty: all before
+/// them, in @p order's order.
 void addStaveSteps(mount::InstallationPlan& plan, const PlannerInput& input, const StaveOrder& order,
-                   const Transform4d& frameToGridMm);
+                   const Transform4d& frameToGridMm,
+                   const std::vector<std::pair<size_t, size_t>>& slots = {});
 
 /// The plan when staves have no direction (−1 in @p order.holes): the staves' steps and a problem
 /// for each stave no hole holds; every other piece placed nowhere (no order is sought for them: the
@@ -289,7 +302,14 @@ using SweepCache = std::map<std::tuple<std::vector<uint32_t>, std::vector<uint32
 /// it may take) finds an order whenever one exists for some choice of directions; the reverse is
 /// the mounting order. The bodies that are left are @p stuck: none of them can go on last among them.
 struct Disassembly {
-    std::vector<uint32_t> order;  ///< mounting order of the bodies that could be placed
+    /// Mounting order of the bodies that could be placed: the staves (fixed bodies) left in place
+    /// throughout first, in their order, then the reverse of the taking away (rings of staves
+    /// taken away among the rest).
+    std::vector<uint32_t> order;
+    size_t ringsTakenAway = 0;  ///< rings of staves taken away among the other bodies (FixedStaves)
+    /// For the debug output, where bodies are stuck: each ring of staves in their way that stays,
+    /// and what keeps it (the bodies its staves' ways meet, "s" after a stave).
+    std::vector<std::string> ringNotes;
     std::vector<int> holes;       ///< per body: its direction; −1 when it has none or is stuck
     /// (a, b): body a must go on before body b: along its chosen direction, a cannot go on after b.
     std::vector<std::pair<uint32_t, uint32_t>> before;
@@ -316,11 +336,19 @@ struct GlueOnRule {
 /// then the highest). A hosted body (MountBody::glueOptions) goes on along a free direction while a
 /// body it can be glued onto (@p glueOn) is in place; hosted bodies leave first, so they go on as
 /// late as they can. Bodies with no direction at all take no part (Disassembly::holes −1).
-/// The last @p fixedCount bodies are in place throughout (staves, put on first): in every other
-/// body's way where they are, never taken away, neither placed nor stuck.
+/// The last @p fixedCount bodies are staves, put on first: in every other body's way where they
+/// are, neither placed nor stuck. Without @p staves they are in place throughout; with it, where no
+/// other body can leave, a whole ring of them is taken away (it goes on after the bodies left)
+/// when every stave of it slid out along its tunnel meets no body left but its ring (facesAllow,
+/// sweepHits), no stave left is glued in place onto it and no body left to be glued on has only
+/// its staves to be glued onto. Of such rings, the last in the staves' order that is in the way of
+/// a body left (or of a ring in such a way) goes; none such: the bodies left are stuck.
+/// (docs/mounting.md, "Three tunnels through one point": the pieces between tunnels whose only
+/// way out is through a tunnel go on before that tunnel's staves.)
 Disassembly disassemble(const std::vector<MountBody>& bodies, const FaceContacts& faces,
                         const Transform4d& frameToGridMm, double voxelMm, const GlueOnRule& glueOn,
-                        SweepCache& cache, const RunContext& context, size_t fixedCount = 0);
+                        SweepCache& cache, const RunContext& context, size_t fixedCount = 0,
+                        const FixedStaves* staves = nullptr);
 
 /// Voxel faces between the pieces of two bodies (their contact area, in voxel faces).
 size_t bodyContact(const MountBody& a, const MountBody& b, const FaceContacts& faces);
