@@ -314,10 +314,31 @@ struct RingPicker {
                 const uint32_t p = bodies[first() + k].pieces[0];
                 staveList += " " + std::to_string(p);
                 std::string in;
-                for (uint32_t a : wayOf(k))
-                    if (isLeft[a] && ringOf(a) != r)
-                        in += " " + std::to_string(bodies[a].pieces[0]) + (ringOf(a) == SIZE_MAX ? "" : "s");
-                if (!in.empty()) note += "; stave " + std::to_string(p) + "'s way meets" + in;
+                const MountBody& me = bodies[first() + k];
+                for (uint32_t a : wayOf(k)) {
+                    if (!isLeft[a] || ringOf(a) == r) continue;
+                    in += " " + std::to_string(bodies[a].pieces[0]) + (ringOf(a) == SIZE_MAX ? "" : "s");
+                    if (ringOf(a) != SIZE_MAX) continue;
+                    bool isTouching = false;
+                    const Box3d& b = bodies[a].bounds;
+                    in += (facesAllow(bodies[a], me, staves.slideGrid[k], faces, &isTouching) ? " (swept"
+                                                                                              : " (face") +
+                          formatNumbers(", its box (%.0f, %.0f, %.0f)-(%.0f, %.0f, %.0f))", b.min[0],
+                                        b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]);
+                }
+                const Vec3d& d = staves.slideGrid[k];
+                if (!in.empty())
+                    note +=
+                        "; stave " + std::to_string(p) +
+                        formatNumbers(" in (%.0f, %.0f, %.0f)-(%.0f, %.0f, %.0f) along (%.2f, %.2f, %.2f)",
+                                      me.bounds.min[0], me.bounds.min[1], me.bounds.min[2], me.bounds.max[0],
+                                      me.bounds.max[1], me.bounds.max[2], d[0], d[1], d[2]) +
+                        ": its way meets" + in;
+                for (size_t j = 0; j < staves.ringOf.size(); ++j)
+                    if (isLeft[first() + j] && staves.ringOf[j] != r &&
+                        std::count(staves.hosts[j].begin(), staves.hosts[j].end(), k))
+                        note += "; stave " + std::to_string(bodies[first() + j].pieces[0]) + " glued onto " +
+                                std::to_string(p) + " is on";
             }
             if (staveList.empty()) continue;
             out.push_back("ring of staves" + staveList +
