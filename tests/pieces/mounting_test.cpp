@@ -298,6 +298,12 @@ TEST_CASE("mounting: every pair of bodies in each other's way is glued into one 
     CHECK(std::count_if(messages.begin(), messages.end(), [](const std::string& m) {
               return m.find("2 pairs glued into one") != std::string::npos;
           }) == 1);
+    // A mouth ring (piece 3, slid into its mouth along x) is never glued into a group: it goes on
+    // after its tunnel's staves, which the piece glued to it may have to go on before.
+    input.sleeves = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {1, 0, 0}};
+    const mount::InstallationPlan ring = planMounting(input, sweeps, faces, 1.0, {kUp, kDown}, 2, context);
+    CHECK_FALSE(ring.isBuildable());
+    CHECK(ring.glued == std::vector<std::pair<uint32_t, uint32_t>>{{0, 1}});
 }
 
 TEST_CASE("mounting: a voxel near one neighbour's seam is still swept against the other bodies") {

@@ -77,9 +77,13 @@ size_t glueStuck(Bodies& bodies, const Disassembly& parts, const PlannerInput& i
         const std::vector<uint32_t>& list = parts.stuckBlockers[k];
         return std::find(list.begin(), list.end(), other) != list.end();
     };
+    // Staves, and mouth rings, which go on after every stave of their tunnel (each lies in their
+    // way out): glued to a face piece that has to go on before some of those staves, a mouth ring
+    // leaves the group no order (the cheese at 700 mm).
     auto hasStave = [&](const MountBody& body) {
-        return std::any_of(body.pieces.begin(), body.pieces.end(),
-                           [&](uint32_t p) { return input.isStave(p); });
+        return std::any_of(body.pieces.begin(), body.pieces.end(), [&](uint32_t p) {
+            return input.isStave(p) || (p < input.sleeves.size() && norm(input.sleeves[p]) > 0.0);
+        });
     };
     std::vector<std::tuple<int, size_t, uint32_t, uint32_t>> pairs;  // (−kind, −contact, a, b)
     for (size_t i = 0; i < parts.stuck.size(); ++i)
