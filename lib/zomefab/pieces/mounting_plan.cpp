@@ -80,10 +80,9 @@ size_t glueStuck(Bodies& bodies, const Disassembly& parts, const PlannerInput& i
     // Staves, and mouth rings, which go on after every stave of their tunnel (each lies in their
     // way out): glued to a face piece that has to go on before some of those staves, a mouth ring
     // leaves the group no order (the cheese at 700 mm).
-    auto hasStave = [&](const MountBody& body) {
-        return std::any_of(body.pieces.begin(), body.pieces.end(), [&](uint32_t p) {
-            return input.isStave(p) || (p < input.sleeves.size() && norm(input.sleeves[p]) > 0.0);
-        });
+    auto isNeverGlued = [&](const MountBody& body) {
+        return std::any_of(body.pieces.begin(), body.pieces.end(),
+                           [&](uint32_t p) { return input.isStave(p) || input.isMouthRing(p); });
     };
     std::vector<std::tuple<int, size_t, uint32_t, uint32_t>> pairs;  // (−kind, −contact, a, b)
     for (size_t i = 0; i < parts.stuck.size(); ++i)
@@ -91,7 +90,7 @@ size_t glueStuck(Bodies& bodies, const Disassembly& parts, const PlannerInput& i
             const uint32_t a = parts.stuck[i];
             const auto other = std::find(parts.stuck.begin(), parts.stuck.end(), b);
             if (b == a || (other != parts.stuck.end() && b < a)) continue;       // each stuck pair once
-            if (hasStave(bodies.list[a]) || hasStave(bodies.list[b])) continue;  // never glued into groups
+            if (isNeverGlued(bodies.list[a]) || isNeverGlued(bodies.list[b])) continue;
             const size_t contact = bodyContact(bodies.list[a], bodies.list[b], faces);
             if (contact == 0) continue;
             int kind = 0;
@@ -241,14 +240,16 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
     SweepCache cache;
     const GlueOnRule glueOn;
     const FixedStaves fixedInfo = fixedStaves(order, input);
-    Disassembly parts = disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache,
-                                    context, fixed, &fixedInfo);
+    auto takeApart = [&] {
+        return disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context, fixed,
+                           &fixedInfo);
+    };
+    Disassembly parts = takeApart();
     // Bodies held by pegs but stuck may be glued on instead, along a direction no peg uses.
     if (!parts.stuck.empty()) {
         for (uint32_t b : parts.stuck)
             if (bodies.list[b].glueOptions.empty()) addGlueOptions(bodies.list[b], holes, sweeps, voxelMm);
-        parts = disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context,
-                            fixed, &fixedInfo);
+        parts = takeApart();
     }
     // Where no order exists, glue stuck bodies that are in each other's way into one (a few times:
     // what gluing does not resolve is re-cut).
@@ -283,8 +284,7 @@ mount::InstallationPlan planMounting(const PlannerInput& input, const FrameSweep
         glues += glued;
         context.debug("mounting: " + std::to_string(parts.stuck.size()) + " bodies stuck, " +
                       std::to_string(glued) + " pairs glued into one");
-        parts = disassemble(bodies.list, faces, sweeps.frameToGridMm(), voxelMm, glueOn, cache, context,
-                            fixed, &fixedInfo);
+        parts = takeApart();
         stall = parts.stuck.size() < fewestStuck ? 0 : stall + 1;
         fewestStuck = std::min(fewestStuck, parts.stuck.size());
     }

@@ -141,6 +141,8 @@ struct PlannerInput {
     bool isGluingUnheldStaves = false;
     /// Whether piece @p p is a stave (staves).
     bool isStave(uint32_t p) const { return p < staves.size() && staves[p].has_value(); }
+    /// Whether piece @p p is a mouth ring (sleeves).
+    bool isMouthRing(uint32_t p) const { return p < sleeves.size() && norm(sleeves[p]) > 0.0; }
 };
 PlannerInput plannerInput(const Pieces& out, const VoxelField& field,
                           const std::vector<TenonCandidate>& candidates);
